@@ -1,0 +1,131 @@
+// Lenses looking at the mirror, in the camera frame (model/types.h).
+//
+// How to add a lens: a struct template over T with kName, kNumParams, kParamsInfo,
+// kIsOrthographic, ProjectToPixel, PixelToRay, CheckDomain, Cast, FromParams/ToParams.
+#pragma once
+
+#include <cmath>
+#include <string>
+
+#include "model/scalar.h"
+#include "model/types.h"
+
+namespace omnical {
+
+// Pinhole with two radial distortion terms (OpenCV's k1, k2):
+// x' = x (1 + k1 r^2 + k2 r^4), r^2 = x^2 + y^2, x = X / Z; u = fx x' + cx.
+// Valid for Z > 0 and, for unprojection, where r (1 + k1 r^2 + k2 r^4) is increasing
+// (checked over the image by the sensor reader).
+template <typename T>
+struct PinholeLens {
+  static constexpr const char* kName = "pinhole";
+  static constexpr int kNumParams = 6;
+  static constexpr const char* kParamsInfo = "fx_px, fy_px, cx_px, cy_px, k1, k2";
+  static constexpr bool kIsOrthographic = false;
+  T fx_px, fy_px, cx_px, cy_px, k1, k2;
+
+  bool ProjectToPixel(const Vec3<T>& point_in_camera, Vec2<T>* pixel) const {
+    if (!(ScalarPart(point_in_camera.z()) > 0.0)) return false;
+    const T x = point_in_camera.x() / point_in_camera.z();
+    const T y = point_in_camera.y() / point_in_camera.z();
+    const T r2 = x * x + y * y;
+    const T radial = T(1.0) + r2 * (k1 + r2 * k2);
+    (*pixel)(0) = fx_px * x * radial + cx_px;
+    (*pixel)(1) = fy_px * y * radial + cy_px;
+    return true;
+  }
+
+  // Undistorted radius r for a distorted radius rd: Newton on r (1 + k1 r^2 + k2 r^4) = rd
+  // in double, then one Newton step in T (implicit-function derivative for Jets).
+  T UndistortRadius(const T& distorted_radius) const {
+    const double rd = ScalarPart(distorted_radius);
+    const double a = ScalarPart(k1), b = ScalarPart(k2);
+    double r = rd;
+    for (int iteration = 0; iteration < 20; ++iteration) {
+      const double r2 = r * r;
+      const double residual = r * (1.0 + r2 * (a + r2 * b)) - rd;
+      const double slope = 1.0 + r2 * (3.0 * a + 5.0 * r2 * b);
+      const double step = residual / slope;
+      r -= step;
+      if (std::abs(step) <= 1e-15 * (1.0 + r)) break;
+    }
+    if constexpr (std::is_same_v<T, double>) {
+      return r;
+    } else {
+      const double r2 = r * r;
+      const double slope = 1.0 + r2 * (3.0 * a + 5.0 * r2 * b);
+      const T rt(r);
+      const T residual = rt * (T(1.0) + rt * rt * (k1 + rt * rt * k2)) - distorted_radius;
+      return rt - residual / slope;
+    }
+  }
+
+  // Ray through the lens centre for a pixel: origin 0, unit direction.
+  void PixelToRay(const Vec2<T>& pixel, Vec3<T>* origin, Vec3<T>* direction) const {
+    using std::sqrt;
+    const T xd = (pixel(0) - cx_px) / fx_px;
+    const T yd = (pixel(1) - cy_px) / fy_px;
+    const T rd2 = xd * xd + yd * yd;
+    T scale(1.0);
+    if (ScalarPart(rd2) > 0.0) {
+      const T rd = sqrt(rd2);
+      scale = UndistortRadius(rd) / rd;
+    }
+    const Vec3<T> ray(xd * scale, yd * scale, T(1.0));
+    *origin = Vec3<T>::Zero();
+    *direction = ray / ray.norm();
+  }
+
+  // Largest focal length, px: converts a length tolerance into a pixel tolerance.
+  double MaxFocalPx() const { return std::max(ScalarPart(fx_px), ScalarPart(fy_px)); }
+
+  std::string CheckDomain() const {
+    if (!(ScalarPart(fx_px) > 0.0) || !(ScalarPart(fy_px) > 0.0)) return "fx and fy must be > 0";
+    return {};
+  }
+  template <typename U>
+  PinholeLens<U> Cast() const {
+    return {CastScalar<U>(fx_px), CastScalar<U>(fy_px), CastScalar<U>(cx_px),
+            CastScalar<U>(cy_px), CastScalar<U>(k1),    CastScalar<U>(k2)};
+  }
+  static PinholeLens FromParams(const T* p) { return {p[0], p[1], p[2], p[3], p[4], p[5]}; }
+  void ToParams(T* p) const {
+    p[0] = fx_px; p[1] = fy_px; p[2] = cx_px; p[3] = cy_px; p[4] = k1; p[5] = k2;
+  }
+};
+
+// Orthographic (telecentric) lens: every ray is parallel to the optical axis.
+// u = s X + cx, v = s Y + cy with s in px per mm.
+template <typename T>
+struct OrthographicLens {
+  static constexpr const char* kName = "orthographic";
+  static constexpr int kNumParams = 3;
+  static constexpr const char* kParamsInfo = "scale_px_per_mm, cx_px, cy_px";
+  static constexpr bool kIsOrthographic = true;
+  T scale_px_per_mm, cx_px, cy_px;
+
+  bool ProjectToPixel(const Vec3<T>& point_in_camera, Vec2<T>* pixel) const {
+    (*pixel)(0) = scale_px_per_mm * point_in_camera.x() + cx_px;
+    (*pixel)(1) = scale_px_per_mm * point_in_camera.y() + cy_px;
+    return true;
+  }
+  void PixelToRay(const Vec2<T>& pixel, Vec3<T>* origin, Vec3<T>* direction) const {
+    *origin = Vec3<T>((pixel(0) - cx_px) / scale_px_per_mm, (pixel(1) - cy_px) / scale_px_per_mm, T(0.0));
+    *direction = Vec3<T>(T(0.0), T(0.0), T(1.0));
+  }
+  double MaxFocalPx() const { return ScalarPart(scale_px_per_mm); }
+  std::string CheckDomain() const {
+    if (!(ScalarPart(scale_px_per_mm) > 0.0)) return "scale_px_per_mm must be > 0";
+    return {};
+  }
+  template <typename U>
+  OrthographicLens<U> Cast() const {
+    return {CastScalar<U>(scale_px_per_mm), CastScalar<U>(cx_px), CastScalar<U>(cy_px)};
+  }
+  static OrthographicLens FromParams(const T* p) { return {p[0], p[1], p[2]}; }
+  void ToParams(T* p) const {
+    p[0] = scale_px_per_mm; p[1] = cx_px; p[2] = cy_px;
+  }
+};
+
+}  // namespace omnical

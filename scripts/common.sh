@@ -1,0 +1,38 @@
+# Shared by scripts/demo.sh and scripts/test.sh: install the Debian packages omnical needs
+# (only the missing ones), then configure and build in Release.
+# Environment: OMNICAL_BUILD_DIR (default: build/<demo|test>, set by the caller through
+# omnical_build_kind), OMNICAL_JOBS (default: nproc).
+
+omnical_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+# demo and test build with different options: separate trees avoid full rebuilds.
+build_dir=${OMNICAL_BUILD_DIR:-$omnical_root/build/${omnical_build_kind:-test}}
+jobs=${OMNICAL_JOBS:-$(nproc)}
+
+# Why each package is here: see README "Dependencies".
+omnical_packages=(
+  g++ cmake ninja-build pkg-config
+  libeigen3-dev libceres-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libboost-dev
+  libopencv-dev libopencv-contrib-dev libapriltag-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+install_dependencies() {
+  local missing=()
+  for package in "${omnical_packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "omnical: installing Debian packages: ${missing[*]}"
+  local sudo=""
+  if [ "$(id -u)" -ne 0 ]; then
+    command -v sudo >/dev/null || { echo "omnical: need root or sudo to install: ${missing[*]}" >&2; return 1; }
+    sudo=sudo
+  fi
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+}
+
+configure_and_build() {
+  cmake -S "$omnical_root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "$@"
+  cmake --build "$build_dir" -j "$jobs"
+}

@@ -1,0 +1,121 @@
+// Ceres Jets through projection agree with central differences of the double model, for
+// every model parameter and the point, aligned and misaligned. This is what a Ceres
+// cost function will see, so it is checked for every profile and lens.
+#include <gtest/gtest.h>
+
+#include <ceres/jet.h>
+
+#include <cmath>
+#include <vector>
+
+#include "model/sensor.h"
+#include "test_sensors.h"
+
+namespace omnical {
+namespace {
+
+constexpr int kMaxParams = 24;
+using Jet = ceres::Jet<double, kMaxParams>;
+
+template <typename T, template <typename> class Profile>
+int ProfileParamCount(const Profile<T>& profile) {
+  if constexpr (std::is_same_v<Profile<T>, EvenPolynomialProfile<T>>) {
+    return profile.NumParams();
+  } else {
+    return Profile<T>::kNumParams;
+  }
+}
+
+// Flattens [profile, lens, pose, point] and rebuilds a model of any scalar from them.
+template <template <typename> class Profile, template <typename> class Lens>
+struct Packed {
+  const Catadioptric<double, Profile, Lens>& base;
+  int num_profile = 0;
+
+  std::vector<double> Flatten(const Eigen::Vector3d& point) const {
+    std::vector<double> values(kMaxParams, 0.0);
+    if constexpr (!std::is_same_v<Profile<double>, TabulatedProfile<double>>) base.mirror.ToParams(values.data());
+    base.lens.ToParams(values.data() + num_profile);
+    base.pose.ToParams(values.data() + num_profile + Lens<double>::kNumParams);
+    for (int k = 0; k < 3; ++k) values[num_profile + Lens<double>::kNumParams + 5 + k] = point[k];
+    return values;
+  }
+  int Count() const { return num_profile + Lens<double>::kNumParams + 5 + 3; }
+
+  template <typename T>
+  ProjectionStatus Project(const std::vector<T>& values, Vec2<T>* pixel) const {
+    Catadioptric<T, Profile, Lens> model;
+    if constexpr (std::is_same_v<Profile<double>, TabulatedProfile<double>>) {
+      model.mirror = base.mirror.template Cast<T>();
+    } else if constexpr (std::is_same_v<Profile<double>, EvenPolynomialProfile<double>>) {
+      model.mirror = Profile<T>::FromParams(values.data(), num_profile);
+    } else {
+      model.mirror = Profile<T>::FromParams(values.data());
+    }
+    model.lens = Lens<T>::FromParams(values.data() + num_profile);
+    model.pose = MirrorPose<T>::FromParams(values.data() + num_profile + Lens<double>::kNumParams);
+    model.rim_radius_mm = base.rim_radius_mm;
+    model.image_width_px = base.image_width_px;
+    model.image_height_px = base.image_height_px;
+    const int p = num_profile + Lens<double>::kNumParams + 5;
+    return model.Project(Vec3<T>(values[p], values[p + 1], values[p + 2]), pixel);
+  }
+};
+
+class JetDerivatives : public ::testing::TestWithParam<int> {};
+
+TEST_P(JetDerivatives, AgreeWithCentralDifferences) {
+  const testing::NamedSensor named = testing::AllTestSensors()[GetParam()];
+  const Sensor sensor(named.model);
+  std::visit(
+      [&](const auto& model) {
+        using Model = std::decay_t<decltype(model)>;
+        Packed<Model::template ProfileOf, Model::template LensOf> packed{model, ProfileParamCount(model.mirror)};
+        int checked = 0;
+        for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(720, 480), Eigen::Vector2d(300, 250),
+                                            Eigen::Vector2d(520, 860), Eigen::Vector2d(560, 530)}) {
+          Eigen::Vector3d origin, direction;
+          ASSERT_EQ(sensor.Unproject(pixel, &origin, &direction), ProjectionStatus::kOk);
+          const std::vector<double> values = packed.Flatten(origin + 5.0 * testing::kRimMm * direction);
+          std::vector<Jet> jets(kMaxParams);
+          for (int k = 0; k < kMaxParams; ++k) jets[k] = Jet(values[k], k);
+          Vec2<Jet> jet_pixel;
+          ASSERT_EQ(packed.Project(jets, &jet_pixel), ProjectionStatus::kOk);
+          for (int k = 0; k < packed.Count(); ++k) {
+            // Step: 1e-5 of the parameter's scale (mm lengths ~ the rim, angles and
+            // distortion ~ 1). Truncation ~ (step/scale)^2 ~ 1e-10 relative; the solvers
+            // converge to ~1e-11 px, far below the ~1e-4 px change over the step.
+            const double scale = std::max(std::abs(values[k]), values[k] == 0.0 ? 1.0 : 0.0);
+            const double step = 1e-5 * scale;
+            std::vector<double> plus = values, minus = values;
+            plus[k] += step;
+            minus[k] -= step;
+            Vec2<double> pixel_plus, pixel_minus;
+            ASSERT_EQ(packed.Project(plus, &pixel_plus), ProjectionStatus::kOk);
+            ASSERT_EQ(packed.Project(minus, &pixel_minus), ProjectionStatus::kOk);
+            for (int axis = 0; axis < 2; ++axis) {
+              const double numeric = (pixel_plus(axis) - pixel_minus(axis)) / (2.0 * step);
+              const double analytic = jet_pixel(axis).v[k];
+              // 1e-6 relative; derivatives whose effect over the step is below 1e-9 px
+              // are below what central differences resolve, so they are compared absolutely.
+              const double tolerance = std::max(1e-6 * std::max(std::abs(analytic), std::abs(numeric)), 1e-9 / step);
+              EXPECT_NEAR(analytic, numeric, tolerance) << named.name << " parameter " << k << " axis " << axis;
+              ++checked;
+            }
+          }
+        }
+        EXPECT_GE(checked, 4 * 2 * packed.Count());
+      },
+      sensor.model());
+}
+
+INSTANTIATE_TEST_SUITE_P(Models, JetDerivatives, ::testing::Range(0, static_cast<int>(testing::AllTestSensors().size())),
+                         [](const ::testing::TestParamInfo<int>& info) {
+                           std::string name = testing::AllTestSensors()[info.param].name;
+                           for (char& c : name)
+                             if (c == '/') c = '_';
+                           return name;
+                         });
+
+}  // namespace
+}  // namespace omnical

@@ -1,0 +1,157 @@
+// Sensor files: the shipped ones load, save -> load is lossless for every model, and bad
+// files give one-line errors naming the file and the field.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "model/input_error.h"
+#include "model/sensor.h"
+#include "test_sensors.h"
+
+namespace omnical {
+namespace {
+
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(SensorYaml, LoadsTheShippedSensors) {
+  for (const char* name : {"ohte-sph", "ohte-edi", "ohte-svp"}) {
+    const Sensor sensor = LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/" + name + ".yaml");
+    EXPECT_TRUE(sensor.is_axial());
+    EXPECT_STREQ(sensor.lens_name(), "pinhole");
+    EXPECT_DOUBLE_EQ(sensor.rim_radius_mm(), 43.9);
+    EXPECT_EQ(sensor.image_width_px(), 1000);
+  }
+}
+
+// Saving and reloading gives the same projections (17 significant digits are written).
+TEST(SensorYaml, SaveThenLoadIsLossless) {
+  // The tabulated profile needs its table on disk.
+  const TabulatedProfile<double> sampled = testing::SampledEdiProfile();
+  const std::string table_path = ::testing::TempDir() + "/sampled_edi.csv";
+  {
+    std::ofstream table(table_path);
+    table.precision(17);
+    table << "r_mm,z_mm\n";
+    for (size_t i = 0; i < sampled.spline->radius_mm().size(); ++i)
+      table << sampled.spline->radius_mm()[i] << "," << sampled.spline->sag_mm()[i] << "\n";
+  }
+  for (testing::NamedSensor& named : testing::AllTestSensors()) {
+    std::visit(
+        [&](auto& model) {
+          if constexpr (std::is_same_v<typename std::decay_t<decltype(model)>::ProfileType, TabulatedProfile<double>>) {
+            model.mirror.source = table_path;
+          }
+        },
+        named.model);
+    const Sensor original(named.model);
+    const std::string path = ::testing::TempDir() + "/saved_sensor.yaml";
+    SaveSensorYaml(original, path);
+    const Sensor loaded = LoadSensorYaml(path);
+    EXPECT_EQ(loaded.model().index(), original.model().index()) << named.name;
+    for (const Eigen::Vector3d& point : {Eigen::Vector3d(300, 40, 100), Eigen::Vector3d(-200, 500, -300)}) {
+      Eigen::Vector2d a, b;
+      ASSERT_EQ(original.Project(point, &a), loaded.Project(point, &b)) << named.name;
+      if (original.Project(point, &a) == ProjectionStatus::kOk) {
+        EXPECT_LT((a - b).norm(), 1e-9) << named.name;
+      }
+    }
+  }
+}
+
+struct BadSensor {
+  const char* name;
+  const char* yaml;
+  const char* expected;  // a part of the one-line message
+};
+
+const char* kGoodCamera =
+    "camera: { model: pinhole, image_size: [1000, 1000], fx: 2352, fy: 2352, cx: 499.5, cy: 499.5 }\n";
+const char* kGoodPose = "pose: { m: 180.4 }\n";
+
+class BadSensorFiles : public ::testing::TestWithParam<BadSensor> {};
+
+TEST_P(BadSensorFiles, FailWithOneLineNamingFileAndField) {
+  const BadSensor& bad = GetParam();
+  const std::string path = WriteTemp(std::string(bad.name) + ".yaml", bad.yaml);
+  try {
+    LoadSensorYaml(path);
+    FAIL() << "no error for " << bad.name;
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    EXPECT_EQ(message.rfind(path, 0), 0u) << message;
+    EXPECT_NE(message.find(bad.expected), std::string::npos) << message;
+  }
+}
+
+std::string Sphere(const std::string& mirror_fields) {
+  return std::string(kGoodCamera) + "mirror: { profile: sphere, rim_radius: 43.9, " + mirror_fields + " }\n" + kGoodPose;
+}
+
+const std::string kMalformed = std::string(kGoodCamera) + "mirror: { profile: sphere, rim_radius: 43.9, A: [1, \n";
+const std::string kUnknownProfile = std::string(kGoodCamera) + "mirror: { profile: cone, rim_radius: 43.9 }\n" + kGoodPose;
+const std::string kNegativeRadius = Sphere("A: -49.9");
+const std::string kRimBeyondSphere = Sphere("A: 40.0");
+const std::string kNegativeRim =
+    std::string(kGoodCamera) + "mirror: { profile: sphere, rim_radius: -43.9, A: 49.9 }\n" + kGoodPose;
+const std::string kNanFocal =
+    "camera: { model: pinhole, image_size: [1000, 1000], fx: .nan, fy: 2352, cx: 499.5, cy: 499.5 }\n"
+    "mirror: { profile: sphere, rim_radius: 43.9, A: 49.9 }\n" + std::string(kGoodPose);
+const std::string kTextNumber = Sphere("A: fifty");
+const std::string kZeroM = std::string(kGoodCamera) + "mirror: { profile: sphere, rim_radius: 43.9, A: 49.9 }\n" +
+                           "pose: { m: 0 }\n";
+const std::string kLensInsideMirror = std::string(kGoodCamera) +
+                                      "mirror: { profile: sphere, rim_radius: 43.9, A: 49.9 }\n"
+                                      "pose: { m: 3, tilt_deg: [40, 0], decenter_mm: [0, 30] }\n";
+const std::string kUnknownField = Sphere("A: 49.9, radius: 3");
+const std::string kMissingPose = std::string(kGoodCamera) + "mirror: { profile: sphere, rim_radius: 43.9, A: 49.9 }\n";
+const std::string kBadImageSize =
+    "camera: { model: pinhole, image_size: [1000, -5], fx: 2352, fy: 2352, cx: 499.5, cy: 499.5 }\n"
+    "mirror: { profile: sphere, rim_radius: 43.9, A: 49.9 }\n" + std::string(kGoodPose);
+const std::string kBadDistortion =
+    "camera: { model: pinhole, image_size: [1000, 1000], fx: 800, fy: 800, cx: 499.5, cy: 499.5, k1: -2.0 }\n"
+    "mirror: { profile: sphere, rim_radius: 43.9, A: 49.9 }\n" + std::string(kGoodPose);
+const std::string kUnknownLens =
+    "camera: { model: fisheye, image_size: [1000, 1000] }\n"
+    "mirror: { profile: sphere, rim_radius: 43.9, A: 49.9 }\n" + std::string(kGoodPose);
+const std::string kMissingTable =
+    std::string(kGoodCamera) + "mirror: { profile: tabulated, rim_radius: 43.9, table: no-such-table.csv }\n" + kGoodPose;
+const std::string kNoCoefficients =
+    std::string(kGoodCamera) + "mirror: { profile: polynomial, rim_radius: 43.9, coefficients: [] }\n" + kGoodPose;
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, BadSensorFiles,
+    ::testing::Values(BadSensor{"malformed", kMalformed.c_str(), "malformed YAML"},
+                      BadSensor{"unknown_profile", kUnknownProfile.c_str(), "mirror.profile: unknown profile 'cone'"},
+                      BadSensor{"negative_radius", kNegativeRadius.c_str(), "mirror.A: must be > 0"},
+                      BadSensor{"rim_beyond_sphere", kRimBeyondSphere.c_str(), "rim_radius must be smaller"},
+                      BadSensor{"negative_rim", kNegativeRim.c_str(), "mirror.rim_radius: must be > 0"},
+                      BadSensor{"nan_focal", kNanFocal.c_str(), "camera.fx: must be finite"},
+                      BadSensor{"text_number", kTextNumber.c_str(), "mirror.A: 'fifty' is not a number"},
+                      BadSensor{"zero_m", kZeroM.c_str(), "pose.m: must be > 0"},
+                      BadSensor{"lens_inside_mirror", kLensInsideMirror.c_str(), "pose.m: the lens centre lies inside"},
+                      BadSensor{"unknown_field", kUnknownField.c_str(), "mirror.radius: unknown field"},
+                      BadSensor{"missing_pose", kMissingPose.c_str(), "pose: missing section"},
+                      BadSensor{"bad_image_size", kBadImageSize.c_str(), "camera.image_size"},
+                      BadSensor{"bad_distortion", kBadDistortion.c_str(), "not invertible within the image"},
+                      BadSensor{"unknown_lens", kUnknownLens.c_str(), "camera.model: unknown lens model 'fisheye'"},
+                      BadSensor{"missing_table", kMissingTable.c_str(), "mirror.table: cannot read the profile table:"},
+                      BadSensor{"no_coefficients", kNoCoefficients.c_str(), "mirror.coefficients: must list 1 to 8"}),
+    [](const ::testing::TestParamInfo<BadSensor>& info) { return std::string(info.param.name); });
+
+TEST(SensorYaml, MissingFileIsReported) {
+  try {
+    LoadSensorYaml("/nonexistent/sensor.yaml");
+    FAIL();
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(), "/nonexistent/sensor.yaml: file not found");
+  }
+}
+
+}  // namespace
+}  // namespace omnical

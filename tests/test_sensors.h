@@ -1,0 +1,87 @@
+// Sensors for the model tests: every profile with every lens, aligned or misaligned
+// (tilt 2 deg + decenter 1 mm, the test case), scaled so the rim images at
+// about 480 px from the centre of a 1000 x 1000 image.
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "model/sensor.h"
+
+namespace omnical::testing {
+
+struct NamedSensor {
+  std::string name;
+  SensorModel model;
+};
+
+inline constexpr double kRimMm = 43.9;
+
+template <template <typename> class Profile, template <typename> class Lens>
+Catadioptric<double, Profile, Lens> MakeModel(const Profile<double>& profile, double m_mm, bool misaligned) {
+  Catadioptric<double, Profile, Lens> model;
+  model.mirror = profile;
+  model.rim_radius_mm = kRimMm;
+  model.image_width_px = 1000;
+  model.image_height_px = 1000;
+  model.pose = {m_mm, 0.0, 0.0, 0.0, 0.0};
+  if (misaligned) {
+    model.pose.tilt_x_rad = 2.0 * M_PI / 180.0;
+    model.pose.tilt_y_rad = -1.2 * M_PI / 180.0;  // 2 deg in total along a skew axis
+    model.pose.decenter_x_mm = 0.6;
+    model.pose.decenter_y_mm = -0.8;  // 1 mm in total
+  }
+  const double rim_sag = profile.EvaluateSag(kRimMm * kRimMm).z;
+  if constexpr (Lens<double>::kIsOrthographic) {
+    model.lens = {480.0 / kRimMm, 499.5, 499.5};
+  } else {
+    const double f_px = 480.0 * (m_mm + rim_sag) / kRimMm;
+    model.lens = {f_px, f_px * 1.001, 499.5, 499.5, 0.0, 0.0};
+  }
+  return model;
+}
+
+// A tabulated profile sampled from the E-DI polynomial (so its shape is known).
+inline TabulatedProfile<double> SampledEdiProfile() {
+  const EvenPolynomialProfile<double> edi = EvenPolynomialProfile<double>::FromParams(
+      std::vector<double>{0.6409 / kRimMm, 0.1550 / std::pow(kRimMm, 3), -0.01 / std::pow(kRimMm, 5)}.data(), 3);
+  std::vector<double> r, z;
+  for (int i = 0; i <= 120; ++i) {
+    r.push_back(1.05 * kRimMm * i / 120.0);
+    z.push_back(edi.EvaluateSag(r.back() * r.back()).z);
+  }
+  TabulatedProfile<double> profile;
+  profile.spline = std::make_shared<const CubicSplineInR2>(r, z);
+  profile.source = "sampled-edi";
+  return profile;
+}
+
+template <template <typename> class Lens>
+std::vector<NamedSensor> SensorsWithLens(const std::string& lens_name, bool misaligned) {
+  const double m = 180.0;
+  const std::string suffix = "/" + lens_name + (misaligned ? "/misaligned" : "/aligned");
+  const EvenPolynomialProfile<double> edi = EvenPolynomialProfile<double>::FromParams(
+      std::vector<double>{0.6409 / kRimMm, 0.1550 / std::pow(kRimMm, 3), -0.01 / std::pow(kRimMm, 5)}.data(), 3);
+  return {
+      {"sphere" + suffix, MakeModel<SphereProfile, Lens>({1.138 * kRimMm}, 4.110 * kRimMm, misaligned)},
+      {"polynomial" + suffix, MakeModel<EvenPolynomialProfile, Lens>(edi, 3.919 * kRimMm, misaligned)},
+      {"hyperboloid" + suffix,
+       MakeModel<HyperboloidProfile, Lens>({0.7407 * kRimMm, 1.698 * kRimMm}, 3.550 * kRimMm, misaligned)},
+      {"paraboloid" + suffix, MakeModel<ParaboloidProfile, Lens>({0.5 * kRimMm}, m, misaligned)},
+      {"tabulated" + suffix, MakeModel<TabulatedProfile, Lens>(SampledEdiProfile(), 3.919 * kRimMm, misaligned)},
+  };
+}
+
+inline std::vector<NamedSensor> AllTestSensors() {
+  std::vector<NamedSensor> all;
+  for (bool misaligned : {false, true}) {
+    for (auto& s : SensorsWithLens<PinholeLens>("pinhole", misaligned)) all.push_back(std::move(s));
+    for (auto& s : SensorsWithLens<OrthographicLens>("orthographic", misaligned)) all.push_back(std::move(s));
+  }
+  return all;
+}
+
+inline std::string SourceDir() { return OMNICAL_SOURCE_DIR; }
+
+}  // namespace omnical::testing
