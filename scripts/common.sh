@@ -13,7 +13,7 @@ omnical_packages=(
   g++ cmake ninja-build pkg-config
   libeigen3-dev libceres-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libboost-dev
   libopencv-dev libopencv-contrib-dev libapriltag-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev python3
 )
 
 install_dependencies() {

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds omnical in Release and runs the main job on the bundled
-# synthetic data. Today that is the sensor model: for each of the seed paper's three
-# mirrors, unproject a pixel grid to rays, put objects 7 mirror radii away along them
-# (the paper's near case) and project them back exactly. The later stages (render ->
-# detect -> calibrate -> parallax report -> remap export) join as their issues land.
+# synthetic data. Today: for each of the seed paper's three mirrors, (1) the sensor model:
+# unproject a pixel grid to rays, put objects 7 mirror radii away along them (the paper's
+# near case) and project them back exactly; (2) the paper's optics evaluation
+# (characterize); (3) the parallax report for objects at n = 7 (parallax). The remaining
+# stages (render -> detect -> calibrate -> remap export) join as their issues land.
 # Output: demo-out/ (or $1).
 set -euo pipefail
 omnical_build_kind=demo
@@ -29,5 +30,7 @@ for mirror in ohte-sph ohte-edi ohte-svp; do
     awk -F, '$9 == "ok" { print $1 "," $2 }' | paste -d, - <(tail -n +2 "$out/$mirror-pixels-n7.csv") |
     awk -F, '{ du = $1 - $3; dv = $2 - $4; e = sqrt(du*du + dv*dv); if (e > w) w = e } END { printf "%.2g", w }')
   echo "$mirror: $rays pixels see the mirror; their objects at n = 7 project back within $worst px ($back ok)"
+  "$omnical" characterize --sensor "$sensor" --out "$out/$mirror-characterize"
+  "$omnical" parallax --sensor "$sensor" --n 7 --out "$out/$mirror-parallax-n7"
 done
 echo "demo outputs in $out"

@@ -9,7 +9,11 @@ namespace omnical::cli {
 
 Command ProjectCommand();
 Command UnprojectCommand();
+Command CharacterizeCommand();
+Command ParallaxCommand();
 
-inline std::vector<Command> AllCommands() { return {ProjectCommand(), UnprojectCommand()}; }
+inline std::vector<Command> AllCommands() {
+  return {ProjectCommand(), UnprojectCommand(), CharacterizeCommand(), ParallaxCommand()};
+}
 
 }  // namespace omnical::cli

@@ -91,5 +91,56 @@ expect_error missing_option "--points is required" -- project --sensor "$sensors
 expect_error unknown_command "" -- frobnicate
 expect_error unwritable_output "cannot create output file" -- project --sensor "$sensors/ohte-sph.yaml" --points "$work/points.csv" --out "/nonexistent-dir/out.csv"
 
+# --- characterize and parallax ---------------------------------------------------------
+# json FILE KEY: a top-level number from a JSON file.
+json() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])" "$1" "$2"; }
+# near VALUE EXPECTED TOLERANCE NAME
+near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; exit !(d <= t && -d <= t) }' && pass || fail "$4: $1, expected $2 +- $3"; }
+
+if "$omnical" -q characterize --sensor "$sensors/ohte-sph.yaml" --lens-f 11.6 --f-number 4 --pixel-um 5.2 \
+    --focus-mm 212 --out "$work/char"; then
+  # Seed Table 1, Sec. 3.3 and Eq. 32 (SEED-NOTES values).
+  near "$(json "$work/char/summary.json" rim_omega_deg)" 135.0 0.05 "rim_omega_deg"
+  near "$(json "$work/char/summary.json" rim_theta_deg)" 12.0 0.05 "rim_theta_deg"
+  near "$(json "$work/char/summary.json" depth_of_field_mm)" 13.9 0.05 "depth_of_field_mm at L0 = 212"
+  near "$(json "$work/char/summary.json" mean_solid_angle_per_pixel_deg2)" 0.0448 0.0001 "mean solid angle per pixel"
+  for f in characteristics.csv fig04_ray_trace.png fig05_image_height.png fig06_viewpoints.png fig07_area_aspect.png \
+      fig08_image_forming.png fig09_blur.png; do
+    [ -s "$work/char/$f" ] && pass || fail "characterize did not write $f"
+  done
+  [ "$(head -c 8 "$work/char/fig04_ray_trace.png" | od -An -tx1 | tr -d ' ')" = "89504e470d0a1a0a" ] && pass ||
+    fail "fig04 is not a PNG"
+else
+  fail "characterize exited $?"
+fi
+"$omnical" -q characterize --sensor "$sensors/ohte-svp.yaml" --out "$work/char-svp" &&
+  near "$(json "$work/char-svp/summary.json" viewpoint_spread_mm)" 0 1e-9 "SVP viewpoint spread" || fail "characterize svp"
+"$omnical" -q characterize --sensor "$sensors/ohte-sph-misaligned.yaml" --out "$work/char-tilted" &&
+  grep -q "aligned counterpart" "$work/char-tilted/summary.json" && pass || fail "characterize misaligned"
+
+# Fig. 15: spherical mirror, best V0.
+for case in "7 4.75 0.2" "40 0.91 0.05"; do
+  set -- $case
+  if "$omnical" -q parallax --sensor "$sensors/ohte-sph.yaml" --n "$1" --out "$work/par$1"; then
+    near "$(json "$work/par$1/parallax.json" max_abs_error_px)" "$2" "$3" "parallax n = $1"
+    [ -s "$work/par$1/error_map.png" ] && [ -s "$work/par$1/parallax.png" ] && [ -s "$work/par$1/parallax.csv" ] && pass ||
+      fail "parallax n = $1 outputs"
+  else
+    fail "parallax n = $1 exited $?"
+  fi
+done
+# The same object distance in mm, and a given V0, are taken as given.
+"$omnical" -q parallax --sensor "$sensors/ohte-sph.yaml" --distance-mm 307.3 --v0 11.0 --out "$work/parmm" &&
+  near "$(json "$work/parmm/parallax.json" v0_mm)" 11.0 1e-12 "parallax --v0" || fail "parallax --distance-mm"
+
+sed 's/image_size: \[1000, 1000\]/image_size: [600, 600]/' "$sensors/ohte-sph.yaml" >"$work/small_image.yaml"
+expect_error parallax_n_zero "--n" -- parallax --sensor "$sensors/ohte-sph.yaml" --n 0 --out "$work/out.csv"
+expect_error parallax_n_negative "--n" -- parallax --sensor "$sensors/ohte-sph.yaml" --n -3 --out "$work/out.csv"
+expect_error parallax_no_distance "--n or --distance-mm" -- parallax --sensor "$sensors/ohte-sph.yaml" --out "$work/out.csv"
+expect_error parallax_both "excludes" -- parallax --sensor "$sensors/ohte-sph.yaml" --n 7 --distance-mm 300 --out "$work/out.csv"
+expect_error characterize_f_number "--f-number" -- characterize --sensor "$sensors/ohte-sph.yaml" --f-number -4 --out "$work/out.csv"
+expect_error characterize_pixel_zero "--pixel-um" -- characterize --sensor "$sensors/ohte-sph.yaml" --pixel-um 0 --out "$work/out.csv"
+expect_error characterize_rim_outside "the mirror rim images outside the 600 x 600 image" -- characterize --sensor "$work/small_image.yaml" --out "$work/out.csv"
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
