@@ -4,7 +4,8 @@
 // Each block takes the table guess, then a fixed number of plain Newton steps (2 for an
 // axial sensor: guess error ~0.2 mm -> ~1e-6 mm -> ~1e-16 mm; 3 for the 2-D Fermat
 // solve, whose seed ignores the misalignment). A point is accepted only when its last
-// step was below the scalar solver's acceptance threshold and every validity check holds;
+// step was below the scalar solver's acceptance threshold (detail::AcceptStep) and every
+// validity check holds;
 // any other point (a poor guess, a point outside the field, NaN) is projected again by
 // the safeguarded scalar solver, which also supplies the failure status. The answers are
 // those of Catadioptric::Project to its tolerance (~1e-10 px).
@@ -23,7 +24,6 @@ void ProjectPointsBatch(const Model& model, const ProjectionCache& cache, const 
   constexpr bool kOrtho = Model::kOrthographic;
   constexpr int kBlock = 256;
   const double rim = model.rim_radius_mm;
-  const double accept_step = 1e-7 * rim;  // as in the scalar solvers
   const bool axial = model.IsAxial();
   const Eigen::Matrix3d& rotation = cache.camera_from_mirror_rotation;
   const Eigen::Vector3d translation = model.pose.CameraFromMirrorTranslation();
@@ -33,7 +33,7 @@ void ProjectPointsBatch(const Model& model, const ProjectionCache& cache, const 
 
   alignas(64) double px[kBlock], py[kBlock], pz[kBlock], rho[kBlock];
   alignas(64) double qx[kBlock], qy[kBlock], last_step[kBlock], ahead[kBlock];
-  alignas(64) double u[kBlock], v[kBlock];
+  alignas(64) double u[kBlock], v[kBlock], distance[kBlock];
   for (long start = 0; start < count; start += kBlock) {
     const int n = static_cast<int>(std::min<long>(kBlock, count - start));
     const double* block = points_xyz + 3 * start;
@@ -71,9 +71,11 @@ void ProjectPointsBatch(const Model& model, const ProjectionCache& cache, const 
         const double x = qx[i], scale = x / rho[i];
         const Vec3<double> mirror_point(px[i] * scale + translation.x(), py[i] * scale + translation.y(),
                                         model.mirror.EvaluateSag(x * x).z + translation.z());
-        Vec2<double> pixel(0.0, 0.0);
-        model.lens.ProjectToPixel(mirror_point, &pixel);
+        Vec2<double> pixel(NAN, NAN);
+        if (!model.lens.ProjectToPixel(mirror_point, &pixel)) pixel.setConstant(NAN);  // fails InImage below
         u[i] = pixel.x(), v[i] = pixel.y();
+        distance[i] = std::sqrt((rho[i] - x) * (rho[i] - x) + (pz[i] - mirror_point.z() + translation.z()) *
+                                                                  (pz[i] - mirror_point.z() + translation.z()));
       }
     } else {
       // 2. Fixed Newton steps on the Fermat condition (vectorised).
@@ -93,9 +95,11 @@ void ProjectPointsBatch(const Model& model, const ProjectionCache& cache, const 
         const Eigen::Vector3d mirror_point =
             rotation * Eigen::Vector3d(qx[i], qy[i], model.mirror.EvaluateSag(qx[i] * qx[i] + qy[i] * qy[i]).z) +
             translation;
-        Vec2<double> pixel(0.0, 0.0);
-        model.lens.ProjectToPixel(mirror_point, &pixel);
+        Vec2<double> pixel(NAN, NAN);
+        if (!model.lens.ProjectToPixel(mirror_point, &pixel)) pixel.setConstant(NAN);  // fails InImage below
         u[i] = pixel.x(), v[i] = pixel.y();
+        const Eigen::Vector3d point(block[3 * i], block[3 * i + 1], block[3 * i + 2]);
+        distance[i] = (point - mirror_point).norm();
       }
     }
 
@@ -103,7 +107,9 @@ void ProjectPointsBatch(const Model& model, const ProjectionCache& cache, const 
     for (int i = 0; i < n; ++i) {
       const double radius = axial ? qx[i] : std::sqrt(qx[i] * qx[i] + qy[i] * qy[i]);
       const Eigen::Vector3d point(block[3 * i], block[3 * i + 1], block[3 * i + 2]);
-      bool ok = last_step[i] < accept_step && radius >= 0.0 && radius <= rim * detail::kRimSlack &&
+      bool ok = std::abs(point.x()) <= detail::kMaxCoordinateMm && std::abs(point.y()) <= detail::kMaxCoordinateMm &&
+                std::abs(point.z()) <= detail::kMaxCoordinateMm &&
+                last_step[i] < detail::AcceptStep(rim, distance[i]) && radius >= 0.0 && radius <= rim * detail::kRimSlack &&
                 rho[i] > 1e-12 * rim && ahead[i] > 0.0 && model.InImage(u[i], v[i]);
       if (ok && model.camera_body_radius_mm > 0.0) {
         Eigen::Vector3d mirror_point;

@@ -116,6 +116,17 @@ namespace detail {
 // pixel would be rejected by a rounding error.
 constexpr double kRimSlack = 1.0 + 1e-12;
 
+// Newton steps below this are accepted (the step itself is applied). Quadratic
+// convergence leaves an error ~ step^2 / L, where L is the length over which the
+// residual bends: the rim radius, or the distance to the point when that is smaller
+// (points very near the mirror). So the remaining error is ~1e-14 L.
+inline double AcceptStep(double rim_mm, double point_distance_mm) {
+  return 1e-7 * std::min(rim_mm, point_distance_mm);
+}
+
+// Beyond this a coordinate's square overflows or the point is numerically at infinity.
+constexpr double kMaxCoordinateMm = 1e30;
+
 inline bool AllFinite(double a, double b, double c = 0.0) {
   return std::isfinite(a) && std::isfinite(b) && std::isfinite(c);
 }
@@ -139,7 +150,6 @@ template <typename Profile>
 ProjectionStatus SolveAxialRadius(bool orthographic, double m_mm, const Profile& mirror, double rim_mm,
                                   double rho, double h, const AxialGuessTable* guess, double* x_out,
                                   double* dg_dx_out) {
-  const double accept_step = 1e-7 * rim_mm;  // next error ~ step^2 / rim: ~1e-14 rim
   const double bisect_tolerance = 1e-13 * rim_mm;  // only reached if Newton keeps failing
   double lo = 0.0, hi = rim_mm;
   bool rim_checked = false;
@@ -168,7 +178,8 @@ ProjectionStatus SolveAxialRadius(bool orthographic, double m_mm, const Profile&
     double x_next = x - r.g / r.dg_dx;
     // A small Newton step is accepted before the bracket test: at the root the bracket
     // collapses onto x and a step of one rounding error would fail it.
-    const bool newton_converged = std::abs(x_next - x) < accept_step;
+    const double distance = std::sqrt((rho - x) * (rho - x) + (h - r.sag_mm) * (h - r.sag_mm));
+    const bool newton_converged = std::abs(x_next - x) < AcceptStep(rim_mm, distance);
     if (!newton_converged && !(x_next > lo && x_next < hi)) {
       if (!rim_checked && !check_rim()) return ProjectionStatus::kOutsideMirror;
       x_next = 0.5 * (lo + hi);
@@ -193,8 +204,9 @@ template <bool kOrtho, typename Profile>
 ProjectionStatus SolveFermatPoint(const Eigen::Vector3d& lens, const Profile& mirror, double rim_mm,
                                   const Eigen::Vector3d& point, double seed_radius, Eigen::Vector2d* q_out,
                                   Eigen::Matrix2d* jacobian_out) {
-  const double accept_step = 1e-7 * rim_mm;
-  const double max_radius = std::min(1.5 * rim_mm, 0.999 * mirror.MaxRadiusMm());
+  // Iterates may pass the rim a little (points just outside the field converge there),
+  // but not far: beyond it a profile is only an extrapolation.
+  const double max_radius = std::min(1.2 * rim_mm, (1.0 - 1e-9) * mirror.MaxRadiusMm());
   const double rho = point.head<2>().norm();
   auto evaluate = [&](const Eigen::Vector2d& q) {
     return EvaluateFermatReflection<kOrtho>(lens.x(), lens.y(), lens.z(), mirror, point.x(), point.y(), point.z(),
@@ -210,7 +222,8 @@ ProjectionStatus SolveFermatPoint(const Eigen::Vector3d& lens, const Profile& mi
       if (!(norm > 0.0)) return ProjectionStatus::kNoSolution;
       step = Eigen::Vector2d(e.f_x, e.f_y) * (0.05 * rim_mm / norm);
     }
-    if (step.norm() < accept_step) {
+    const double distance = (point - Eigen::Vector3d(q.x(), q.y(), e.z)).norm();
+    if (step.norm() < AcceptStep(rim_mm, distance)) {
       *q_out = q + step;
       *jacobian_out << e.j_xx, e.j_xy, e.j_xy, e.j_yy;
       const Eigen::Vector3d to_point = point - Eigen::Vector3d(q.x(), q.y(), e.z);
@@ -305,7 +318,8 @@ ProjectionStatus ReflectionPointImpl(const Catadioptric<T, Profile, Lens>& model
   constexpr bool kJet = !std::is_same_v<T, double>;
   constexpr bool kOrtho = Lens<T>::kIsOrthographic;
   const Eigen::Vector3d point_d = ToDouble(point_in_camera);
-  if (!AllFinite(point_d.x(), point_d.y(), point_d.z())) return ProjectionStatus::kInvalidInput;
+  if (!AllFinite(point_d.x(), point_d.y(), point_d.z()) || point_d.cwiseAbs().maxCoeff() > kMaxCoordinateMm)
+    return ProjectionStatus::kInvalidInput;
   const double rim = model.rim_radius_mm;
   const AxialGuessTable* guess = cache != nullptr ? &cache->guess : nullptr;
   const Eigen::Vector3d translation_d = model_d.pose.CameraFromMirrorTranslation();
@@ -334,11 +348,6 @@ ProjectionStatus ReflectionPointImpl(const Catadioptric<T, Profile, Lens>& model
         SolveAxialRadius(kOrtho, model_d.pose.m_mm, model_d.mirror, rim, rho, p.z(), guess, &x, &dg_dx);
     if (status != ProjectionStatus::kOk) return status;
     q = (x / rho) * p.head<2>();
-    if constexpr (kJet) {
-      const FermatReflection e = EvaluateFermatReflection<kOrtho>(lens_d.x(), lens_d.y(), lens_d.z(), model_d.mirror,
-                                                                  p.x(), p.y(), p.z(), q.x(), q.y());
-      jacobian << e.j_xx, e.j_xy, e.j_xy, e.j_yy;
-    }
   } else {
     const double seed = (guess != nullptr && guess->valid()) ? std::min(guess->Guess(rho, p.z()), rim) : 0.5 * rim;
     const ProjectionStatus status = SolveFermatPoint<kOrtho>(lens_d, model_d.mirror, rim, p, seed, &q, &jacobian);
@@ -347,6 +356,10 @@ ProjectionStatus ReflectionPointImpl(const Catadioptric<T, Profile, Lens>& model
   // 2. The mirror point in the camera frame. Jets always take the general 2-D
   // implicit-function step, so tilt and decenter get their derivatives even at 0.
   if constexpr (kJet) {
+    // The Jacobian at the root itself (the solvers' last one is one step before it).
+    const FermatReflection at_root = EvaluateFermatReflection<kOrtho>(lens_d.x(), lens_d.y(), lens_d.z(),
+                                                                      model_d.mirror, p.x(), p.y(), p.z(), q.x(), q.y());
+    jacobian << at_root.j_xx, at_root.j_xy, at_root.j_xy, at_root.j_yy;
     const Mat3<T> rotation = model.pose.CameraFromMirrorRotation();
     const Vec3<T> translation = model.pose.CameraFromMirrorTranslation();
     const Vec3<T> point_in_mirror = rotation.transpose() * (point_in_camera - translation);

@@ -4,8 +4,10 @@
 // kIsOrthographic, ProjectToPixel, PixelToRay, CheckDomain, Cast, FromParams/ToParams.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 #include "model/scalar.h"
 #include "model/types.h"
@@ -35,28 +37,35 @@ struct PinholeLens {
     return true;
   }
 
-  // Undistorted radius r for a distorted radius rd: Newton on r (1 + k1 r^2 + k2 r^4) = rd
-  // in double, then one Newton step in T (implicit-function derivative for Jets).
+  // Undistorted radius r for a distorted radius rd: safeguarded Newton on
+  // F(r) = r (1 + k1 r^2 + k2 r^4) = rd in double (bracket grown from rd, bisection when a
+  // step leaves it; the sensor reader guarantees F is monotone with slope >= 0.1 where it
+  // is used), then one Newton step in T (implicit-function derivative for Jets).
   T UndistortRadius(const T& distorted_radius) const {
     const double rd = ScalarPart(distorted_radius);
     const double a = ScalarPart(k1), b = ScalarPart(k2);
-    double r = rd;
-    for (int iteration = 0; iteration < 20; ++iteration) {
-      const double r2 = r * r;
-      const double residual = r * (1.0 + r2 * (a + r2 * b)) - rd;
-      const double slope = 1.0 + r2 * (3.0 * a + 5.0 * r2 * b);
-      const double step = residual / slope;
-      r -= step;
-      if (std::abs(step) <= 1e-15 * (1.0 + r)) break;
+    auto f = [&](double r) { return r * (1.0 + r * r * (a + r * r * b)) - rd; };
+    auto slope_at = [&](double r) { return 1.0 + r * r * (3.0 * a + 5.0 * r * r * b); };
+    double lo = 0.0, hi = std::max(rd, 1e-300);
+    for (int grow = 0; grow < 60 && f(hi) < 0.0; ++grow) lo = hi, hi *= 2.0;
+    double r = std::min(std::max(rd, lo), hi);
+    for (int iteration = 0; iteration < 100; ++iteration) {
+      const double value = f(r);
+      if (value < 0.0) lo = r; else hi = r;
+      double next = r - value / slope_at(r);
+      // As in the mirror solvers: a converged step is taken before the bracket test, which
+      // a step of one rounding error at the bracket's end would fail.
+      const bool converged = std::abs(next - r) <= 1e-15 * (1.0 + r);
+      if (!converged && !(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      r = next;
+      if (converged || hi - lo <= 1e-15 * (1.0 + r)) break;
     }
     if constexpr (std::is_same_v<T, double>) {
       return r;
     } else {
-      const double r2 = r * r;
-      const double slope = 1.0 + r2 * (3.0 * a + 5.0 * r2 * b);
       const T rt(r);
       const T residual = rt * (T(1.0) + rt * rt * (k1 + rt * rt * k2)) - distorted_radius;
-      return rt - residual / slope;
+      return rt - residual / slope_at(r);
     }
   }
 
@@ -104,7 +113,9 @@ struct OrthographicLens {
   static constexpr bool kIsOrthographic = true;
   T scale_px_per_mm, cx_px, cy_px;
 
+  // Valid in front of the lens plane (Z > 0), where its rays come from.
   bool ProjectToPixel(const Vec3<T>& point_in_camera, Vec2<T>* pixel) const {
+    if (!(ScalarPart(point_in_camera.z()) > 0.0)) return false;
     (*pixel)(0) = scale_px_per_mm * point_in_camera.x() + cx_px;
     (*pixel)(1) = scale_px_per_mm * point_in_camera.y() + cy_px;
     return true;

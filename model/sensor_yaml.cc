@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <set>
@@ -61,9 +62,18 @@ class FieldReader {
   double NumberOr(const YAML::Node& map, const std::string& key, const std::string& section, double fallback) const {
     return map[key] ? Number(map[key], section + "." + key) : fallback;
   }
-  double Positive(const YAML::Node& map, const std::string& key, const std::string& section) const {
+  // Strictly positive and below an upper bound that keeps the geometry representable
+  // (squares and products of lengths must not overflow a double).
+  double Positive(const YAML::Node& map, const std::string& key, const std::string& section,
+                  double max_value = 1e6) const {
     const double value = Number(map, key, section);
     if (!(value > 0.0)) Fail(section + "." + key, "must be > 0 (got " + Format(value) + ")");
+    if (!(value <= max_value)) Fail(section + "." + key, "must be <= " + Format(max_value) + " (got " + Format(value) + ")");
+    return value;
+  }
+  double Bounded(const YAML::Node& node, const std::string& field, double limit) const {
+    const double value = Number(node, field);
+    if (!(std::abs(value) <= limit)) Fail(field, "magnitude must be <= " + Format(limit) + " (got " + Format(value) + ")");
     return value;
   }
   std::vector<double> Numbers(const YAML::Node& node, const std::string& field, size_t min_count,
@@ -115,23 +125,24 @@ LensChoice ReadCamera(const FieldReader& reader, const YAML::Node& root) {
       reader.Fail("camera.image_size", "must be two positive whole numbers [width, height]");
   lens.width = static_cast<int>(wh[0]);
   lens.height = static_cast<int>(wh[1]);
-  lens.body_radius_mm = reader.NumberOr(camera, "body_radius_mm", "camera", 0.0);
+  lens.body_radius_mm = camera["body_radius_mm"] ? reader.Bounded(camera["body_radius_mm"], "camera.body_radius_mm", 1e5) : 0.0;
   if (lens.body_radius_mm < 0.0) reader.Fail("camera.body_radius_mm", "must be >= 0");
   if (model == "pinhole") {
     reader.RejectUnknown(camera, "camera", {"model", "image_size", "fx", "fy", "cx", "cy", "k1", "k2", "body_radius_mm"});
     PinholeLens<double>& p = lens.pinhole;
-    p.fx_px = reader.Positive(camera, "fx", "camera");
-    p.fy_px = reader.Positive(camera, "fy", "camera");
-    p.cx_px = reader.Number(camera, "cx", "camera");
-    p.cy_px = reader.Number(camera, "cy", "camera");
-    p.k1 = reader.NumberOr(camera, "k1", "camera", 0.0);
-    p.k2 = reader.NumberOr(camera, "k2", "camera", 0.0);
+    p.fx_px = reader.Positive(camera, "fx", "camera", 1e8);
+    p.fy_px = reader.Positive(camera, "fy", "camera", 1e8);
+    if (p.fx_px < 1e-3 || p.fy_px < 1e-3) reader.Fail("camera.fx", "focal lengths below 1e-3 px are not a camera");
+    p.cx_px = reader.Bounded(camera["cx"], "camera.cx", 1e7);
+    p.cy_px = reader.Bounded(camera["cy"], "camera.cy", 1e7);
+    p.k1 = camera["k1"] ? reader.Bounded(camera["k1"], "camera.k1", 1e6) : 0.0;
+    p.k2 = camera["k2"] ? reader.Bounded(camera["k2"], "camera.k2", 1e6) : 0.0;
   } else if (model == "orthographic") {
     reader.RejectUnknown(camera, "camera", {"model", "image_size", "scale_px_per_mm", "cx", "cy", "body_radius_mm"});
     lens.is_orthographic = true;
-    lens.orthographic.scale_px_per_mm = reader.Positive(camera, "scale_px_per_mm", "camera");
-    lens.orthographic.cx_px = reader.Number(camera, "cx", "camera");
-    lens.orthographic.cy_px = reader.Number(camera, "cy", "camera");
+    lens.orthographic.scale_px_per_mm = reader.Positive(camera, "scale_px_per_mm", "camera", 1e6);
+    lens.orthographic.cx_px = reader.Bounded(camera["cx"], "camera.cx", 1e7);
+    lens.orthographic.cy_px = reader.Bounded(camera["cy"], "camera.cy", 1e7);
   } else {
     reader.Fail("camera.model", "unknown lens model '" + model + "' (expected pinhole or orthographic)");
   }
@@ -152,6 +163,8 @@ MirrorPose<double> ReadPose(const FieldReader& reader, const YAML::Node& root) {
   }
   if (pose["decenter_mm"]) {
     const std::vector<double> decenter = reader.Numbers(pose["decenter_mm"], "pose.decenter_mm", 2, 2);
+    for (double d : decenter)
+      if (std::abs(d) > 1e5) reader.Fail("pose.decenter_mm", "magnitude must be <= 1e5 mm");
     out.decenter_x_mm = decenter[0];
     out.decenter_y_mm = decenter[1];
   }
@@ -184,10 +197,11 @@ SensorModel ReadMirror(const FieldReader& reader, const YAML::Node& root, const 
                        const MirrorPose<double>& pose) {
   const YAML::Node mirror = reader.Section(root, "mirror");
   const std::string profile = reader.Text(mirror, "profile", "mirror");
-  const double rim = reader.Positive(mirror, "rim_radius", "mirror");
+  const double rim = reader.Positive(mirror, "rim_radius", "mirror", 1e5);
+  if (rim < 1e-3) reader.Fail("mirror.rim_radius", "must be >= 1e-3 mm");
   if (profile == "sphere") {
     reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "A"});
-    return Assemble(SphereProfile<double>{reader.Positive(mirror, "A", "mirror")}, lens, pose, rim);
+    return Assemble(SphereProfile<double>{reader.Positive(mirror, "A", "mirror", 1e7)}, lens, pose, rim);
   }
   if (profile == "polynomial") {
     reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "coefficients"});
@@ -198,13 +212,13 @@ SensorModel ReadMirror(const FieldReader& reader, const YAML::Node& root, const 
   }
   if (profile == "hyperboloid") {
     reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "A", "B"});
-    return Assemble(HyperboloidProfile<double>{reader.Positive(mirror, "A", "mirror"),
-                                               reader.Positive(mirror, "B", "mirror")},
+    return Assemble(HyperboloidProfile<double>{reader.Positive(mirror, "A", "mirror", 1e7),
+                                               reader.Positive(mirror, "B", "mirror", 1e7)},
                     lens, pose, rim);
   }
   if (profile == "paraboloid") {
     reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "A"});
-    return Assemble(ParaboloidProfile<double>{reader.Positive(mirror, "A", "mirror")}, lens, pose, rim);
+    return Assemble(ParaboloidProfile<double>{reader.Positive(mirror, "A", "mirror", 1e7)}, lens, pose, rim);
   }
   if (profile == "tabulated") {
     reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "table"});
@@ -225,30 +239,95 @@ SensorModel ReadMirror(const FieldReader& reader, const YAML::Node& root, const 
 
 }  // namespace
 
+namespace {
+
+std::string Describe(const char* format, double a, double b = 0.0) {
+  char text[200];
+  std::snprintf(text, sizeof text, format, a, b);
+  return text;
+}
+
+// The distortion r (1 + k1 r^2 + k2 r^4) must be monotone, and not nearly flat, wherever it
+// is used: up to the undistorted radius of the mirror's outermost point (projection) and up
+// to the distorted radius of the image corners (unprojection). Its slope
+// 1 + 3 k1 u + 5 k2 u^2 (u = r^2) is a quadratic, so the first u where it drops to
+// kMinSlope is found exactly.
+std::string CheckDistortion(const PinholeLens<double>& lens, double max_undistorted, double max_distorted) {
+  constexpr double kMinSlope = 0.1;  // below this the inverse amplifies errors > 10x
+  const double a = 5.0 * lens.k2, b = 3.0 * lens.k1, c = 1.0 - kMinSlope;
+  double u_fold = HUGE_VAL;
+  if (a == 0.0) {
+    if (b < 0.0) u_fold = -c / b;
+  } else {
+    const double disc = b * b - 4.0 * a * c;
+    if (disc >= 0.0) {
+      const double root = std::sqrt(disc);
+      for (double u : {(-b - root) / (2.0 * a), (-b + root) / (2.0 * a)})
+        if (u > 0.0) u_fold = std::min(u_fold, u);
+    }
+  }
+  if (!std::isfinite(u_fold)) return {};
+  const double r_fold = std::sqrt(u_fold);
+  const double rd_fold = r_fold * (1.0 + u_fold * (lens.k1 + u_fold * lens.k2));
+  if (r_fold <= max_undistorted || rd_fold <= max_distorted)
+    return Describe("camera.k1: radial distortion (k1, k2) folds or flattens (slope < 0.1) at normalised radius %.4g, "
+                    "inside the image or the mirror's image",
+                    r_fold);
+  return {};
+}
+
+}  // namespace
+
 std::string ValidateSensorModel(const SensorModel& model) {
   return std::visit(
       [](const auto& m) -> std::string {
         using Model = std::decay_t<decltype(m)>;
         if (std::string why = m.mirror.CheckDomain(m.rim_radius_mm); !why.empty()) return "mirror: " + why;
         if (std::string why = m.lens.CheckDomain(); !why.empty()) return "camera: " + why;
-        // The lens centre must sit below the mirror surface (outside the mirror body).
         const Eigen::Matrix3d rotation = m.pose.CameraFromMirrorRotation();
-        const Eigen::Vector3d lens_in_mirror = -(rotation.transpose() * m.pose.CameraFromMirrorTranslation());
-        const double r2 = lens_in_mirror.head<2>().squaredNorm();
-        if (r2 < m.rim_radius_mm * m.rim_radius_mm &&
-            !(lens_in_mirror.z() < m.mirror.EvaluateSag(r2).z))
+        const Eigen::Vector3d translation = m.pose.CameraFromMirrorTranslation();
+        const Eigen::Vector3d lens_in_mirror = -(rotation.transpose() * translation);
+        const Eigen::Vector3d lens_direction = -rotation.row(2).transpose();  // orthographic
+        const double r2_lens = lens_in_mirror.head<2>().squaredNorm();
+        if (r2_lens < m.rim_radius_mm * m.rim_radius_mm && !(lens_in_mirror.z() < m.mirror.EvaluateSag(r2_lens).z))
           return "pose.m: the lens centre lies inside the mirror (m too small for this tilt/decenter)";
+        // The solvers need (1) a mirror convex towards the camera: z' > 0 and z'' > 0 out to the
+        // rim (unique reflection point, monotone Omega); (2) seen from its front all the way to
+        // the rim: the lens on the outer side of every tangent plane (else the rim zone is the
+        // hidden back of the surface); (3) in front of the lens.
+        constexpr int kRadii = 400;
+        const int azimuths = m.IsAxial() ? 1 : 72;
+        double max_tan = 0.0;
+        for (int i = 1; i <= kRadii; ++i) {
+          const double r = m.rim_radius_mm * i / kRadii;
+          const SagDerivatives<double> sag = m.mirror.EvaluateSag(r * r);
+          double slope = 0.0, curvature = 0.0;
+          RadialSlopes(sag, r, &slope, &curvature);
+          if (!(sag.dz_ds > 0.0) || !(curvature > 0.0))
+            return Describe("mirror: the profile is not convex towards the camera at r = %.4g mm (z' = %.3g): "
+                            "omnical's solvers need z' > 0 and z'' > 0 out to the rim",
+                            r, slope);
+          for (int k = 0; k < azimuths; ++k) {
+            const double phi = 2.0 * M_PI * k / azimuths;
+            const Eigen::Vector3d point(r * std::cos(phi), r * std::sin(phi), sag.z);
+            const Eigen::Vector3d normal(slope * std::cos(phi), slope * std::sin(phi), -1.0);  // outward
+            const double facing = Model::kOrthographic ? lens_direction.dot(normal) : (lens_in_mirror - point).dot(normal);
+            if (!(facing > 0.0))
+              return Describe("mirror.rim_radius: the lens sees the mirror edge-on at r = %.4g mm, before the rim "
+                              "(azimuth %.0f deg): rim_radius too large for this profile and pose",
+                              r, phi * 180.0 / M_PI);
+            const Eigen::Vector3d in_camera = rotation * point + translation;
+            if (!(in_camera.z() > 0.0))
+              return Describe("pose: part of the mirror lies behind the lens plane (r = %.4g mm, azimuth %.0f deg)", r,
+                              phi * 180.0 / M_PI);
+            max_tan = std::max(max_tan, in_camera.head<2>().norm() / in_camera.z());
+          }
+        }
         if constexpr (!Model::kOrthographic) {
-          // Unprojection inverts the radial distortion: it must be monotone over the image.
           const double corner_u = std::max(std::abs(m.lens.cx_px + 0.5), std::abs(m.image_width_px - 0.5 - m.lens.cx_px));
           const double corner_v = std::max(std::abs(m.lens.cy_px + 0.5), std::abs(m.image_height_px - 0.5 - m.lens.cy_px));
-          const double rd_max = std::hypot(corner_u / m.lens.fx_px, corner_v / m.lens.fy_px);
-          for (double r = 0.0;; r += 1e-3 * (1.0 + rd_max)) {
-            const double r2d = r * r;
-            if (1.0 + r2d * (3.0 * m.lens.k1 + 5.0 * r2d * m.lens.k2) <= 0.0)
-              return "camera.k1: radial distortion (k1, k2) is not invertible within the image";
-            if (r * (1.0 + r2d * (m.lens.k1 + r2d * m.lens.k2)) >= rd_max) break;
-          }
+          const double max_distorted = std::hypot(corner_u / m.lens.fx_px, corner_v / m.lens.fy_px);
+          if (std::string why = CheckDistortion(m.lens, max_tan, max_distorted); !why.empty()) return why;
         }
         return {};
       },
@@ -267,8 +346,8 @@ Sensor LoadSensorYaml(const std::string& path) {
     reader.Fail("", std::string("cannot read: ") + error.what());
   }
   if (!root.IsMap()) reader.Fail("", "expected a map with camera, mirror and pose sections");
-  reader.RejectUnknown(root, "(top level)", {"camera", "mirror", "pose"});
   try {
+    reader.RejectUnknown(root, "(top level)", {"camera", "mirror", "pose"});
     const LensChoice lens = ReadCamera(reader, root);
     const MirrorPose<double> pose = ReadPose(reader, root);
     SensorModel model = ReadMirror(reader, root, lens, pose);

@@ -14,7 +14,8 @@ CubicSplineInR2::CubicSplineInR2(std::vector<double> radius_mm, std::vector<doub
   const size_t n = radius_mm_.size();
   if (n < 4 || sag_.size() != n)
     throw std::invalid_argument("a profile table needs at least 4 (r, z) rows");
-  if (radius_mm_[0] != 0.0) throw std::invalid_argument("the first row must be at r = 0 (the vertex)");
+  if (radius_mm_[0] != 0.0 || sag_[0] != 0.0)
+    throw std::invalid_argument("the first row must be the vertex, r = 0 and z = 0");
   for (size_t i = 1; i < n; ++i)
     if (!(radius_mm_[i] > radius_mm_[i - 1]))
       throw std::invalid_argument("r must increase strictly (row " + std::to_string(i + 1) + ")");
@@ -42,6 +43,8 @@ CubicSplineInR2::CubicSplineInR2(std::vector<double> radius_mm, std::vector<doub
     second_[i] = (rhs[i] - upper[i] * second_[i + 1]) / diag[i];
     if (i == 1) break;
   }
+  const double h = r2_[n - 1] - r2_[n - 2];
+  end_slope_ = (sag_[n - 1] - sag_[n - 2]) / h + h * (second_[n - 2] + 2.0 * second_[n - 1]) / 6.0;
 }
 
 int CubicSplineInR2::Segment(double r2) const {

@@ -26,6 +26,10 @@ class CubicSplineInR2 {
 
   template <typename S>
   SagDerivatives<S> Evaluate(const S& r2) const {
+    // Beyond the last sample: continue along the end tangent (in r^2). A cubic would turn
+    // over within a few mm and give solvers iterating past the rim spurious roots.
+    const int last = static_cast<int>(r2_.size()) - 1;
+    if (ScalarPart(r2) > r2_[last]) return {S(sag_[last]) + S(end_slope_) * (r2 - S(r2_[last])), S(end_slope_), S(0.0)};
     const int i = Segment(ScalarPart(r2));
     const double h = r2_[i + 1] - r2_[i];
     const S b = (r2 - S(r2_[i])) / S(h);
@@ -50,6 +54,7 @@ class CubicSplineInR2 {
   std::vector<double> r2_;
   std::vector<double> sag_;
   std::vector<double> second_;  // d2z/ds2 at the knots
+  double end_slope_ = 0.0;      // dz/ds at the last knot
   double max_radius_mm_ = 0.0;
 };
 

@@ -77,6 +77,8 @@ class BadSensorFiles : public ::testing::TestWithParam<BadSensor> {};
 
 TEST_P(BadSensorFiles, FailWithOneLineNamingFileAndField) {
   const BadSensor& bad = GetParam();
+  WriteTemp("lifted_table.csv", "r,z\n0,1\n1,1.1\n2,1.4\n3,1.9\n");
+  WriteTemp("wavy_table.csv", "r,z\n0,0\n1,0.1\n2,0.4\n3,0.5\n4,0.9\n");
   const std::string path = WriteTemp(std::string(bad.name) + ".yaml", bad.yaml);
   try {
     LoadSensorYaml(path);
@@ -116,6 +118,34 @@ const std::string kBadImageSize =
 const std::string kBadDistortion =
     "camera: { model: pinhole, image_size: [1000, 1000], fx: 800, fy: 800, cx: 499.5, cy: 499.5, k1: -2.0 }\n"
     "mirror: { profile: sphere, rim_radius: 43.9, A: 49.9 }\n" + std::string(kGoodPose);
+// Found by review: each of these loaded before and then gave wrong pixels or hung.
+const std::string kFlatDistortion =  // monotone, but with slope 0.003 (inverse amplifies errors ~300x)
+    "camera: { model: pinhole, image_size: [1000, 1000], fx: 600, fy: 600, cx: 499.5, cy: 499.5, k1: -2.4, k2: 2.6 }\n"
+    "mirror: { profile: sphere, rim_radius: 43.9, A: 49.9 }\n" + std::string(kGoodPose);
+const std::string kBallMirror = std::string(kGoodCamera) +  // rim beyond the silhouette seen from the lens
+                                "mirror: { profile: sphere, rim_radius: 43.9, A: 44 }\n" + kGoodPose;
+const std::string kConcave =
+    std::string(kGoodCamera) + "mirror: { profile: polynomial, rim_radius: 43.9, coefficients: [-0.01] }\n" + kGoodPose;
+const std::string kInflected = std::string(kGoodCamera) +
+                               "mirror: { profile: polynomial, rim_radius: 43.9, coefficients: [0.01, 0, -8e-10] }\n"
+                               "pose: { m: 180, tilt_deg: [1, 0] }\n";
+const std::string kFlatMirror =
+    std::string(kGoodCamera) + "mirror: { profile: polynomial, rim_radius: 43.9, coefficients: [0.0] }\n" + kGoodPose;
+const std::string kTinyFocal =
+    "camera: { model: pinhole, image_size: [1000, 1000], fx: 1e-200, fy: 1e-200, cx: 499.5, cy: 499.5 }\n"
+    "mirror: { profile: sphere, rim_radius: 43.9, A: 49.9 }\n" + std::string(kGoodPose);
+const std::string kHugeRim =
+    std::string(kGoodCamera) + "mirror: { profile: sphere, rim_radius: 1e200, A: 1e201 }\n" + kGoodPose;
+const std::string kMirrorBehindLens =
+    "camera: { model: orthographic, image_size: [2000, 2000], scale_px_per_mm: 10, cx: 999.5, cy: 999.5 }\n"
+    "mirror: { profile: paraboloid, rim_radius: 60, A: 20 }\n"
+    "pose: { m: 2, tilt_deg: [40, 0] }\n";
+const std::string kNonStringKey = "? [a, b]\n: 1\ncamera: {model: pinhole}\n";
+const std::string kTableWithoutVertex =
+    std::string(kGoodCamera) + "mirror: { profile: tabulated, rim_radius: 3, table: lifted_table.csv }\n" + kGoodPose;
+const std::string kWavyTable =
+    std::string(kGoodCamera) + "mirror: { profile: tabulated, rim_radius: 4, table: wavy_table.csv }\n" + kGoodPose;
+
 const std::string kUnknownLens =
     "camera: { model: fisheye, image_size: [1000, 1000] }\n"
     "mirror: { profile: sphere, rim_radius: 43.9, A: 49.9 }\n" + std::string(kGoodPose);
@@ -138,7 +168,18 @@ INSTANTIATE_TEST_SUITE_P(
                       BadSensor{"unknown_field", kUnknownField.c_str(), "mirror.radius: unknown field"},
                       BadSensor{"missing_pose", kMissingPose.c_str(), "pose: missing section"},
                       BadSensor{"bad_image_size", kBadImageSize.c_str(), "camera.image_size"},
-                      BadSensor{"bad_distortion", kBadDistortion.c_str(), "not invertible within the image"},
+                      BadSensor{"bad_distortion", kBadDistortion.c_str(), "camera.k1: radial distortion (k1, k2) folds"},
+                      BadSensor{"flat_distortion", kFlatDistortion.c_str(), "camera.k1: radial distortion (k1, k2) folds or flattens"},
+                      BadSensor{"ball_mirror_edge_on", kBallMirror.c_str(), "mirror.rim_radius: the lens sees the mirror edge-on"},
+                      BadSensor{"concave_mirror", kConcave.c_str(), "mirror: the profile is not convex towards the camera"},
+                      BadSensor{"inflected_mirror", kInflected.c_str(), "mirror: the profile is not convex towards the camera at r = 30"},
+                      BadSensor{"flat_mirror", kFlatMirror.c_str(), "mirror: the profile is not convex"},
+                      BadSensor{"tiny_focal", kTinyFocal.c_str(), "camera.fx: focal lengths below 1e-3 px"},
+                      BadSensor{"huge_rim", kHugeRim.c_str(), "mirror.rim_radius: must be <= 100000"},
+                      BadSensor{"mirror_behind_lens", kMirrorBehindLens.c_str(), "pose: part of the mirror lies behind the lens plane"},
+                      BadSensor{"non_string_key", kNonStringKey.c_str(), "unexpected YAML structure"},
+                      BadSensor{"table_without_vertex", kTableWithoutVertex.c_str(), "the first row must be the vertex"},
+                      BadSensor{"wavy_table", kWavyTable.c_str(), "mirror: the profile is not convex"},
                       BadSensor{"unknown_lens", kUnknownLens.c_str(), "camera.model: unknown lens model 'fisheye'"},
                       BadSensor{"missing_table", kMissingTable.c_str(), "mirror.table: cannot read the profile table:"},
                       BadSensor{"no_coefficients", kNoCoefficients.c_str(), "mirror.coefficients: must list 1 to 8"}),
