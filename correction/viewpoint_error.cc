@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "model/minimize_1d.h"
+
 namespace omnical {
 
 double ViewpointAngleErrorRad(const AxialRayQuantities& ray, double object_distance_mm, double v0_z_mm) {
@@ -50,28 +52,7 @@ double BestViewpointMm(const std::vector<FieldSample>& field, double object_dist
     hi = std::max(hi, s.ray.viewpoint_z_mm);
   }
   const double margin = 0.1 * (hi - lo) + 1e-6;
-  lo -= margin;
-  hi += margin;
-  constexpr int kScan = 100;
-  int best = 0;
-  double best_worst = HUGE_VAL;
-  for (int i = 0; i <= kScan; ++i) {
-    const double w = worst(lo + (hi - lo) * i / kScan);
-    if (w < best_worst) best_worst = w, best = i;
-  }
-  double a = lo + (hi - lo) * std::max(best - 1, 0) / kScan;
-  double b = lo + (hi - lo) * std::min(best + 1, kScan) / kScan;
-  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
-  double c1 = b - ratio * (b - a), c2 = a + ratio * (b - a);
-  double f1 = worst(c1), f2 = worst(c2);
-  while (b - a > 1e-9) {
-    if (f1 < f2) {
-      b = c2, c2 = c1, f2 = f1, c1 = b - ratio * (b - a), f1 = worst(c1);
-    } else {
-      a = c1, c1 = c2, f1 = f2, c2 = a + ratio * (b - a), f2 = worst(c2);
-    }
-  }
-  return 0.5 * (a + b);
+  return MinimizeScanThenBrent(worst, lo - margin, hi + margin, 100);
 }
 
 }  // namespace omnical

@@ -33,8 +33,7 @@ struct ParallaxCurve {
 ParallaxCurve ComputeParallaxCurve(const std::vector<FieldSample>& field, double object_distance_mm, double v0_mm);
 
 // The V0 that minimises the worst absolute pixel error over the field (minimax; the
-// worst error is quasi-convex in V0): coarse scan over the viewpoint range, then golden
-// section to 1e-9 mm.
+// worst error is quasi-convex in V0): coarse scan over the viewpoint range, then Brent.
 double BestViewpointMm(const std::vector<FieldSample>& field, double object_distance_mm);
 
 }  // namespace omnical

@@ -1,5 +1,7 @@
 #include "model/optics.h"
 
+#include "model/minimize_1d.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -146,28 +148,7 @@ double BestFocusDistanceMm(const std::vector<FieldSample>& field, const BlurSett
   }
   lo = std::max(lo, 1.01 * lens.lens_focal_mm);  // a real image needs L0 > f
   auto cost = [&](double l0) { return MeanBlurAreaDeg2(field, lens, l0); };
-  // Coarse scan (the cost need not be unimodal over the whole range), then golden section
-  // in the bracket around the best scan point.
-  constexpr int kScan = 200;
-  int best = 0;
-  double best_cost = HUGE_VAL;
-  for (int i = 0; i <= kScan; ++i) {
-    const double c = cost(lo + (hi - lo) * i / kScan);
-    if (c < best_cost) best_cost = c, best = i;
-  }
-  double a = lo + (hi - lo) * std::max(best - 1, 0) / kScan;
-  double b = lo + (hi - lo) * std::min(best + 1, kScan) / kScan;
-  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
-  double c1 = b - ratio * (b - a), c2 = a + ratio * (b - a);
-  double f1 = cost(c1), f2 = cost(c2);
-  while (b - a > 1e-6 * (1.0 + std::abs(a))) {
-    if (f1 < f2) {
-      b = c2, c2 = c1, f2 = f1, c1 = b - ratio * (b - a), f1 = cost(c1);
-    } else {
-      a = c1, c1 = c2, f1 = f2, c2 = a + ratio * (b - a), f2 = cost(c2);
-    }
-  }
-  const double l0 = 0.5 * (a + b);
+  const double l0 = MinimizeScanThenBrent(cost, lo, hi, 200);
   if (mean_area_deg2 != nullptr) *mean_area_deg2 = cost(l0);
   return l0;
 }

@@ -73,8 +73,8 @@ BlurSpot BlurAt(const FieldSample& sample, const BlurSettings& lens, double focu
 
 // The in-focus distance L0 that minimises the overall blur: the solid-angle weighted
 // mean (weight sin(Omega) dOmega) of the blur-spot area in square degrees over the field.
-// Searched over the range of the virtual images' lens distances: coarse scan, then golden
-// section. Returns the mean area at the optimum too.
+// Searched over the range of the virtual images' lens distances (coarse scan, then Brent).
+// Returns the mean area at the optimum too.
 double BestFocusDistanceMm(const std::vector<FieldSample>& field, const BlurSettings& lens,
                            double* mean_area_deg2 = nullptr);
 double MeanBlurAreaDeg2(const std::vector<FieldSample>& field, const BlurSettings& lens, double focus_distance_mm);

@@ -36,3 +36,9 @@ configure_and_build() {
   cmake -S "$omnical_root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "$@"
   cmake --build "$build_dir" -j "$jobs"
 }
+
+# The demo tree: Release, no tests or benchmarks (demo.sh and figures.sh).
+prepare_demo_build() {
+  install_dependencies
+  configure_and_build -DOMNICAL_BUILD_TESTS=OFF -DOMNICAL_BUILD_BENCHMARKS=OFF
+}

@@ -9,8 +9,7 @@
 set -euo pipefail
 omnical_build_kind=demo
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
-install_dependencies
-configure_and_build -DOMNICAL_BUILD_TESTS=OFF -DOMNICAL_BUILD_BENCHMARKS=OFF
+prepare_demo_build
 omnical="$build_dir/tools/omnical"
 out=${1:-$omnical_root/demo-out}
 mkdir -p "$out"
