@@ -46,6 +46,11 @@ FieldSample AnalyzeSample(const Model& model, double x, double near_distance_mm)
     dtheta_dx = dt_dx / (1.0 + t2);
   }
   const double domega_dx = 2.0 * fpp / (1.0 + fp * fp) + dtheta_dx;  // d(2 beta + theta)/dx
+  // Envelope of the rays P(x) + t (sin Omega, -cos Omega): cross(P' + t r', r) = 0 with
+  // P' = (1, f') and r' = Omega' (cos Omega, sin Omega) gives t = -(cos Omega + f' sin Omega) / Omega'.
+  const double t_caustic = -(std::cos(ray.omega_rad) + fp * std::sin(ray.omega_rad)) / domega_dx;
+  sample.caustic_x_mm = x + t_caustic * std::sin(ray.omega_rad);
+  sample.caustic_z_mm = ray.z_mm - t_caustic * std::cos(ray.omega_rad);
   sample.dh_domega_px_per_rad = dh_dx / domega_dx;                    // Eq. 8
   sample.delta_h_px = sample.dh_domega_px_per_rad / kDegPerRad;       // Eq. 9
   sample.delta_w_px = sample.h_px / (kDegPerRad * std::sin(ray.omega_rad));  // Eq. 10

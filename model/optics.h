@@ -43,6 +43,9 @@ struct FieldSample {
   double sagittal_curvature_per_mm;    // 1 / R_s (Eq. 17)
   VirtualImage tangential_far, sagittal_far;    // object at infinity
   VirtualImage tangential_near, sagittal_near;  // object at near_distance_mm from P
+  // The caustic: the envelope of the object rays in the cross-section, where neighbouring
+  // rays meet (behind the mirror for a convex one). A single viewpoint makes it a point.
+  double caustic_x_mm, caustic_z_mm;
 };
 
 // Samples the field at n radii x_i = rim * i / n, i = 1..n. Throws std::invalid_argument

@@ -68,6 +68,27 @@ TEST(VirtualImages, SingleViewpointMirrorHasNoAstigmatism) {
   }
 }
 
+// The caustic of a single-viewpoint mirror is one point, the viewpoint; the sphere's is a
+// curve whose axial extent matches its viewpoint spread in order of magnitude.
+TEST(Viewpoints, CausticOfTheSingleViewpointMirrorIsItsFocus) {
+  const std::vector<FieldSample> svp = AnalyzeField(Shipped("ohte-svp"), 270, kNearMm);
+  for (const FieldSample& f : svp) {
+    EXPECT_NEAR(f.caustic_x_mm, 0.0, 1e-9);
+    EXPECT_NEAR(f.caustic_z_mm, f.ray.viewpoint_z_mm, 1e-9);
+  }
+  const std::vector<FieldSample> sph = AnalyzeField(Shipped("ohte-sph"), 270, kNearMm);
+  // Each ray touches the caustic: the caustic point lies on the ray's line.
+  for (const FieldSample& f : sph) {
+    const double along_x = f.caustic_x_mm - f.ray.x_mm, along_z = f.caustic_z_mm - f.ray.z_mm;
+    EXPECT_NEAR(along_x * -std::cos(f.ray.omega_rad) - along_z * std::sin(f.ray.omega_rad), 0.0, 1e-9);
+  }
+  // Not a point: the sphere's caustic spans millimetres (a curve from the paraxial
+  // viewpoint out towards the rim).
+  const auto [lowest, highest] = std::minmax_element(
+      sph.begin(), sph.end(), [](const FieldSample& a, const FieldSample& b) { return a.caustic_z_mm < b.caustic_z_mm; });
+  EXPECT_GT(highest->caustic_z_mm - lowest->caustic_z_mm, 1.0);
+}
+
 // Sec. 3.4: the sphere's tangential images stay within the depth of field at its best
 // focus; its sagittal images do not.
 TEST(VirtualImages, SphereTangentialImagesFitTheDepthOfField) {

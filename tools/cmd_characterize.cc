@@ -131,11 +131,19 @@ void WriteFigures(const Options& options, const Sensor& sensor, const std::vecto
     WritePng((dir / "fig05_image_height.png").string(), TilePanels({RenderPanel(h, 700, 500), RenderPanel(dh, 700, 500)}, 2));
   }
 
-  // Fig. 6: viewpoint distribution.
+  // Fig. 6: viewpoint distribution, and the caustic in the cross-section.
   {
     PlotPanel panel{"Viewpoint distribution, Eq. 6 (seed Fig. 6)", "Omega (deg)", "z_v (mm, mirror frame)"};
     panel.series.push_back(Line("z_v", omega, Column(field, [](const FieldSample& f) { return f.ray.viewpoint_z_mm; }), 0));
-    WritePng((dir / "fig06_viewpoints.png").string(), RenderPanel(panel, 800, 550));
+    PlotPanel caustic{"Caustic (envelope of the object rays)", "x (mm)", "z (mm, mirror frame)"};
+    caustic.series.push_back(Line("caustic", Column(field, [](const FieldSample& f) { return f.caustic_x_mm; }),
+                                  Column(field, [](const FieldSample& f) { return f.caustic_z_mm; }), 1));
+    caustic.series.push_back(Line("viewpoints on the axis", std::vector<double>(field.size(), 0.0),
+                                  Column(field, [](const FieldSample& f) { return f.ray.viewpoint_z_mm; }), 0));
+    caustic.series.back().markers_only = true;
+    caustic.equal_aspect = true;
+    WritePng((dir / "fig06_viewpoints.png").string(),
+             TilePanels({RenderPanel(panel, 700, 500), RenderPanel(caustic, 700, 500)}, 2));
   }
 
   // Fig. 7: area and aspect ratio of a 1 x 1 deg object.
@@ -225,6 +233,11 @@ void Run(const Options& options, const Context& context) {
   if (options.focus_mm) mean_blur_area = MeanBlurAreaDeg2(field, lens, focus_mm);
   const double dof_mm = DepthOfFieldMm(lens, focus_mm);
 
+  double caustic_x = 0.0, caustic_z_lo = HUGE_VAL, caustic_z_hi = -HUGE_VAL;
+  for (const FieldSample& f : field) {
+    caustic_x = std::max(caustic_x, std::abs(f.caustic_x_mm));
+    caustic_z_lo = std::min(caustic_z_lo, f.caustic_z_mm), caustic_z_hi = std::max(caustic_z_hi, f.caustic_z_mm);
+  }
   double z_lo = HUGE_VAL, z_hi = -HUGE_VAL, astigmatism = 0.0, worst_blur = 0.0, slope_lo = HUGE_VAL, slope_hi = 0.0;
   for (const FieldSample& f : field) {
     z_lo = std::min(z_lo, f.ray.viewpoint_z_mm), z_hi = std::max(z_hi, f.ray.viewpoint_z_mm);
@@ -238,7 +251,7 @@ void Run(const Options& options, const Context& context) {
     out << "x_mm,z_mm,omega_deg,theta_deg,beta_deg,gamma_deg,viewpoint_z_mm,h_px,dh_domega_px_per_deg,"
            "delta_w_px,delta_s_px2,aspect_ratio,tangential_curvature_per_mm,sagittal_curvature_per_mm,"
            "t_inf_x_mm,t_inf_z_mm,s_inf_x_mm,s_inf_z_mm,t_near_x_mm,t_near_z_mm,s_near_x_mm,s_near_z_mm,"
-           "L_t_inf_mm,L_s_inf_mm,blur_t_px,blur_s_px,blur_t_deg,blur_s_deg,blur_area_deg2\n"
+           "L_t_inf_mm,L_s_inf_mm,blur_t_px,blur_s_px,blur_t_deg,blur_s_deg,blur_area_deg2,caustic_x_mm,caustic_z_mm\n"
         << std::setprecision(10);
     for (const FieldSample& f : field) {
       const BlurSpot b = BlurAt(f, lens, focus_mm);
@@ -251,7 +264,8 @@ void Run(const Options& options, const Context& context) {
           << f.tangential_near.x_mm << ',' << f.tangential_near.z_mm << ',' << f.sagittal_near.x_mm << ','
           << f.sagittal_near.z_mm << ',' << f.tangential_far.lens_distance_mm << ','
           << f.sagittal_far.lens_distance_mm << ',' << b.tangential_px << ',' << b.sagittal_px << ','
-          << b.tangential_deg << ',' << b.sagittal_deg << ',' << b.area_deg2 << '\n';
+          << b.tangential_deg << ',' << b.sagittal_deg << ',' << b.area_deg2 << ',' << f.caustic_x_mm << ','
+          << f.caustic_z_mm << '\n';
     }
   });
 
@@ -267,6 +281,7 @@ void Run(const Options& options, const Context& context) {
   summary["rim_h_px"] = field.back().h_px;
   summary["viewpoint_spread_mm"] = z_hi - z_lo;
   summary["viewpoint_range_mm"] = {z_lo, z_hi};
+  summary["caustic_extent_mm"] = {{"radial", caustic_x}, {"axial", caustic_z_hi - caustic_z_lo}};
   summary["max_astigmatism_mm"] = astigmatism;
   summary["dh_domega_px_per_deg"] = {{"min", slope_lo}, {"max", slope_hi}, {"at_rim", field.back().delta_h_px}};
   summary["lens_focal_mm"] = lens.lens_focal_mm;
