@@ -334,17 +334,10 @@ std::string ValidateSensorModel(const SensorModel& model) {
       model);
 }
 
-Sensor LoadSensorYaml(const std::string& path) {
-  const FieldReader reader(path);
-  if (!std::filesystem::exists(path)) reader.Fail("", "file not found");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::ParserException& error) {
-    reader.Fail("line " + std::to_string(error.mark.line + 1), "malformed YAML: " + error.msg);
-  } catch (const YAML::Exception& error) {
-    reader.Fail("", std::string("cannot read: ") + error.what());
-  }
+namespace {
+
+Sensor SensorFromRoot(const YAML::Node& root, const FieldReader& reader) {
+  const std::string& path = reader.path();
   if (!root.IsMap()) reader.Fail("", "expected a map with camera, mirror and pose sections");
   try {
     reader.RejectUnknown(root, "(top level)", {"camera", "mirror", "pose"});
@@ -356,6 +349,33 @@ Sensor LoadSensorYaml(const std::string& path) {
   } catch (const YAML::Exception& error) {
     reader.Fail("", std::string("unexpected YAML structure: ") + error.what());
   }
+}
+
+}  // namespace
+
+Sensor LoadSensorYaml(const std::string& path) {
+  const FieldReader reader(path);
+  if (!std::filesystem::exists(path)) reader.Fail("", "file not found");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::ParserException& error) {
+    reader.Fail("line " + std::to_string(error.mark.line + 1), "malformed YAML: " + error.msg);
+  } catch (const YAML::Exception& error) {
+    reader.Fail("", std::string("cannot read: ") + error.what());
+  }
+  return SensorFromRoot(root, reader);
+}
+
+Sensor ParseSensorYaml(const std::string& yaml_text, const std::string& source) {
+  const FieldReader reader(source);
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& error) {
+    reader.Fail("", std::string("malformed YAML: ") + error.what());
+  }
+  return SensorFromRoot(root, reader);
 }
 
 void SaveSensorYaml(const Sensor& sensor, const std::string& path) {

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds omnical in Release and runs the main job on the bundled
-# synthetic data. Today: for each of the seed paper's three mirrors, (1) the sensor model:
+# synthetic data. Today: (0) render the near-target scene of the spherical mirror
+# (8 views, with ground truth); then for each of the seed paper's three mirrors, (1) the sensor model:
 # unproject a pixel grid to rays, put objects 7 mirror radii away along them (the paper's
 # near case) and project them back exactly; (2) the paper's optics evaluation
 # (characterize); (3) the parallax report for objects at n = 7 (parallax). The remaining
-# stages (render -> detect -> calibrate -> remap export) join as their issues land.
+# stages (detect -> calibrate -> remap export) join as their issues land.
 # Output: demo-out/ (or $1).
 set -euo pipefail
 omnical_build_kind=demo
@@ -13,6 +14,7 @@ prepare_demo_build
 omnical="$build_dir/tools/omnical"
 out=${1:-$omnical_root/demo-out}
 mkdir -p "$out"
+"$omnical" render --scene "$omnical_root/datasets-synthetic/scenes/ohte-sph-near.yaml" --out "$out/render-ohte-sph-near"
 
 for mirror in ohte-sph ohte-edi ohte-svp; do
   sensor="$omnical_root/datasets-synthetic/sensors/$mirror.yaml"

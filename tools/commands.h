@@ -11,9 +11,11 @@ Command ProjectCommand();
 Command UnprojectCommand();
 Command CharacterizeCommand();
 Command ParallaxCommand();
+Command TargetCommand();
+Command RenderCommand();
 
 inline std::vector<Command> AllCommands() {
-  return {ProjectCommand(), UnprojectCommand(), CharacterizeCommand(), ParallaxCommand()};
+  return {ProjectCommand(), UnprojectCommand(), CharacterizeCommand(), ParallaxCommand(), TargetCommand(), RenderCommand()};
 }
 
 }  // namespace omnical::cli

@@ -4,7 +4,7 @@
 # no output file left behind). Usage: cli_test.sh OMNICAL_BINARY SOURCE_DIR
 set -u
 omnical=$1
-source_dir=$2
+source_dir=$(cd "$2" && pwd)
 sensors=$source_dir/datasets-synthetic/sensors
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -141,6 +141,53 @@ expect_error parallax_both "excludes" -- parallax --sensor "$sensors/ohte-sph.ya
 expect_error characterize_f_number "--f-number" -- characterize --sensor "$sensors/ohte-sph.yaml" --f-number -4 --out "$work/out.csv"
 expect_error characterize_pixel_zero "--pixel-um" -- characterize --sensor "$sensors/ohte-sph.yaml" --pixel-um 0 --out "$work/out.csv"
 expect_error characterize_rim_outside "the mirror rim images outside the 600 x 600 image" -- characterize --sensor "$work/small_image.yaml" --out "$work/out.csv"
+
+# --- target and render ---------------------------------------------------------------------
+targets=$source_dir/datasets-synthetic/targets
+if "$omnical" -q target --spec "$targets/aprilgrid-6x6-30mm.yaml" --out "$work/grid.png" --dpi 50; then
+  # 243 mm at 50 dpi = 478 px (true scale).
+  size=$(python3 -c "import struct,sys; d=open(sys.argv[1],'rb').read(24); print(*struct.unpack('>II', d[16:24]))" "$work/grid.png")
+  [ "$size" = "478 478" ] && pass || fail "target png size $size, expected 478 478"
+else
+  fail "target png"
+fi
+"$omnical" -q target --spec "$targets/checkerboard-8x6-30mm.yaml" --out "$work/cb.svg" &&
+  grep -q 'width="330mm" height="270mm"' "$work/cb.svg" && pass || fail "target svg size"
+"$omnical" -q target --spec "$targets/aprilgrid-6x6-30mm.yaml" --out "$work/grid.pdf" &&
+  grep -aq "MediaBox \[0 0 688.818897" "$work/grid.pdf" && tail -c 6 "$work/grid.pdf" | grep -q "%%EOF" && pass ||
+  fail "target pdf"
+expect_error target_format "unknown format '.jpg'" -- target --spec "$targets/aprilgrid-6x6-30mm.yaml" --out "$work/out.jpg"
+
+cat >"$work/scene.yaml" <<YAML
+sensor: $sensors/ohte-sph.yaml
+render: { samples_per_pixel: 1 }
+targets: { board: $targets/aprilgrid-6x6-30mm.yaml }
+views:
+  - { name: one, board: { omega_deg: 70, distance_n: 6 } }
+YAML
+if "$omnical" -q render --scene "$work/scene.yaml" --out "$work/render"; then
+  [ -s "$work/render/one.png" ] && [ -s "$work/render/sensor.yaml" ] && [ -s "$work/render/scene.json" ] && pass ||
+    fail "render outputs"
+  visible=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['targets'][0]['visible_corners'])" "$work/render/one.json")
+  [ "$visible" = 144 ] && pass || fail "render ground truth: $visible visible corners, expected 144"
+  # The saved sensor is the one rendered: it loads and projects the same.
+  "$omnical" project --sensor "$work/render/sensor.yaml" --points "$work/points.csv" | cmp -s - <(
+    "$omnical" project --sensor "$sensors/ohte-sph.yaml" --points "$work/points.csv") && pass || fail "render sensor.yaml"
+else
+  fail "render exited $?"
+fi
+sed 's/omega_deg: 70/omega_deg: 170/' "$work/scene.yaml" >"$work/scene_behind.yaml"
+printf 'target_type: aprilgrid\ntagCols: 6\ntagRows: 6\ntagSize: 0.03\ntagSpacing: 0.3\ntagFamily: tag99\n' >"$work/tag99.yaml"
+printf 'target_type: aprilgrid\ntagCols: 6\ntagRows: 6\ntagSize: 0\ntagSpacing: 0.3\n' >"$work/zero.yaml"
+sed "s#$targets/aprilgrid-6x6-30mm.yaml#$work/tag99.yaml#" "$work/scene.yaml" >"$work/scene_tag99.yaml"
+sed "s#$targets/aprilgrid-6x6-30mm.yaml#$work/zero.yaml#" "$work/scene.yaml" >"$work/scene_zero.yaml"
+printf 'sensor: [unclosed\n' >"$work/scene_bad.yaml"
+expect_error render_target_behind "views[0].board: the target centre is not seen in the mirror" -- render --scene "$work/scene_behind.yaml" --out "$work/out.csv"
+expect_error render_missing_family "tagFamily: unknown tag family 'tag99'" -- render --scene "$work/scene_tag99.yaml" --out "$work/out.csv"
+expect_error render_zero_size "tagSize: must be > 0" -- render --scene "$work/scene_zero.yaml" --out "$work/out.csv"
+expect_error render_unreadable "scene_bad.yaml: line" -- render --scene "$work/scene_bad.yaml" --out "$work/out.csv"
+expect_error render_missing "nope.yaml: file not found" -- render --scene "$work/nope.yaml" --out "$work/out.csv"
+expect_error target_zero_size "zero.yaml: tagSize: must be > 0" -- target --spec "$work/zero.yaml" --out "$work/out.png"
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
