@@ -3,7 +3,6 @@
 #include <apriltag/apriltag.h>
 #include <apriltag/tag36h11.h>
 #include <apriltag/tagStandard41h12.h>
-#include <yaml-cpp/yaml.h>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -12,11 +11,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <set>
 #include <sstream>
 
 #include "model/atomic_write.h"
 #include "model/input_error.h"
+#include "model/yaml_field_reader.h"
 
 namespace omnical {
 namespace {
@@ -38,88 +37,52 @@ bool FindFamily(const std::string& name, FamilyHandle* handle) {
   return false;
 }
 
-class SpecReader {
- public:
-  SpecReader(std::string path, YAML::Node root) : path_(std::move(path)), root_(std::move(root)) {}
-  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
-    throw InputError(InputMessage(path_, field, problem));
-  }
-  double Number(const std::string& key) const {
-    const YAML::Node node = root_[key];
-    if (!node) Fail(key, "missing");
-    double value = 0.0;
-    try {
-      value = node.as<double>();
-    } catch (const YAML::Exception&) {
-      Fail(key, "'" + (node.IsScalar() ? node.Scalar() : std::string("(not a scalar)")) + "' is not a number");
-    }
-    if (!std::isfinite(value)) Fail(key, "must be finite");
-    return value;
-  }
-  int Count(const std::string& key, int minimum) const {
-    const double value = Number(key);
-    if (value != std::floor(value) || value < minimum || value > 10000)
-      Fail(key, "must be a whole number >= " + std::to_string(minimum));
-    return static_cast<int>(value);
-  }
-  double PositiveMetres(const std::string& key) const {
-    const double value = Number(key);
-    if (!(value > 0.0)) Fail(key, "must be > 0 (metres)");
-    if (value > 100.0) Fail(key, "must be <= 100 m (the spec is in metres, Kalibr's unit)");
-    return value;
-  }
-  void RejectUnknown(const std::set<std::string>& known) const {
-    for (const auto& entry : root_) {
-      const std::string key = entry.first.as<std::string>();
-      if (!known.count(key)) Fail(key, "unknown field for this target_type");
-    }
-  }
-  const YAML::Node& root() const { return root_; }
+// Kalibr's counts and sizes (metres) on top of the shared reader.
+int Count(const YamlFieldReader& reader, const YAML::Node& root, const std::string& key, int minimum) {
+  const double value = reader.Number(root[key], key);
+  if (value != std::floor(value) || value < minimum || value > 10000)
+    reader.Fail(key, "must be a whole number >= " + std::to_string(minimum));
+  return static_cast<int>(value);
+}
 
- private:
-  std::string path_;
-  YAML::Node root_;
-};
+double PositiveMetres(const YamlFieldReader& reader, const YAML::Node& root, const std::string& key) {
+  const double value = reader.Number(root[key], key);
+  if (!(value > 0.0)) reader.Fail(key, "must be > 0 (metres)");
+  if (value > 100.0) reader.Fail(key, "must be <= 100 m (the spec is in metres, Kalibr's unit)");
+  return value;
+}
 
 }  // namespace
 
 CalibrationTarget CalibrationTarget::FromYaml(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw InputError(InputMessage(path, "", "file not found"));
-  YAML::Node root;
+  const YamlFieldReader reader(path);
+  const YAML::Node root = reader.LoadFile();
+  if (!root.IsMap()) reader.Fail("", "expected a map with target_type and its fields");
   try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::ParserException& error) {
-    throw InputError(InputMessage(path, "line " + std::to_string(error.mark.line + 1), "malformed YAML: " + error.msg));
-  } catch (const YAML::Exception& error) {
-    throw InputError(InputMessage(path, "", std::string("cannot read: ") + error.what()));
-  }
-  if (!root.IsMap()) throw InputError(InputMessage(path, "", "expected a map with target_type and its fields"));
-  try {
-    const SpecReader reader(path, root);
-    if (!root["target_type"]) reader.Fail("target_type", "missing (aprilgrid or checkerboard)");
-    const std::string type = root["target_type"].as<std::string>();
+    const std::string type = reader.Text(root["target_type"], "target_type");
     if (type == "aprilgrid") {
-      reader.RejectUnknown({"target_type", "tagCols", "tagRows", "tagSize", "tagSpacing", "codeOffset", "tagFamily"});
-      const std::string family = root["tagFamily"] ? root["tagFamily"].as<std::string>() : "tag36h11";
+      reader.RejectUnknown(root, "", {"target_type", "tagCols", "tagRows", "tagSize", "tagSpacing", "codeOffset", "tagFamily"});
+      const std::string family = root["tagFamily"] ? reader.Text(root["tagFamily"], "tagFamily") : "tag36h11";
       FamilyHandle handle;
       if (!FindFamily(family, &handle)) reader.Fail("tagFamily", "unknown tag family '" + family + "' (tag36h11 or tagStandard41h12)");
-      const int offset = root["codeOffset"] ? reader.Count("codeOffset", 0) : 0;
+      const int offset = root["codeOffset"] ? Count(reader, root, "codeOffset", 0) : 0;
       try {
-        return AprilGrid(reader.Count("tagCols", 1), reader.Count("tagRows", 1), 1000.0 * reader.PositiveMetres("tagSize"),
-                         reader.Number("tagSpacing"), family, offset);
+        return AprilGrid(Count(reader, root, "tagCols", 1), Count(reader, root, "tagRows", 1),
+                         1000.0 * PositiveMetres(reader, root, "tagSize"), reader.Number(root["tagSpacing"], "tagSpacing"),
+                         family, offset);
       } catch (const std::invalid_argument& error) {
         throw InputError(path + ": " + error.what());  // the message names its field
       }
     }
     if (type == "checkerboard") {
-      reader.RejectUnknown({"target_type", "targetCols", "targetRows", "rowSpacingMeters", "colSpacingMeters"});
-      return Checkerboard(reader.Count("targetCols", 2), reader.Count("targetRows", 2),
-                          1000.0 * reader.PositiveMetres("colSpacingMeters"),
-                          1000.0 * reader.PositiveMetres("rowSpacingMeters"));
+      reader.RejectUnknown(root, "", {"target_type", "targetCols", "targetRows", "rowSpacingMeters", "colSpacingMeters"});
+      return Checkerboard(Count(reader, root, "targetCols", 2), Count(reader, root, "targetRows", 2),
+                          1000.0 * PositiveMetres(reader, root, "colSpacingMeters"),
+                          1000.0 * PositiveMetres(reader, root, "rowSpacingMeters"));
     }
     reader.Fail("target_type", "unknown target type '" + type + "' (aprilgrid or checkerboard)");
   } catch (const YAML::Exception& error) {
-    throw InputError(InputMessage(path, "", std::string("unexpected YAML structure: ") + error.what()));
+    reader.Fail("", std::string("unexpected YAML structure: ") + error.what());
   }
 }
 

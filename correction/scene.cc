@@ -1,67 +1,19 @@
 #include "correction/scene.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <Eigen/Geometry>
 #include <cmath>
 #include <filesystem>
 #include <random>
-#include <set>
 
 #include "model/input_error.h"
+#include "model/yaml_field_reader.h"
 
 namespace omnical {
 namespace {
 
 constexpr double kRad = M_PI / 180.0;
 
-class SceneReader {
- public:
-  explicit SceneReader(std::string path) : path_(std::move(path)) {}
-  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
-    throw InputError(InputMessage(path_, field, problem));
-  }
-  void RejectUnknown(const YAML::Node& map, const std::string& where, const std::set<std::string>& known) const {
-    if (!map.IsMap()) Fail(where, "must be a map");
-    for (const auto& entry : map) {
-      const std::string key = entry.first.as<std::string>();
-      if (!known.count(key)) Fail(where + "." + key, "unknown field");
-    }
-  }
-  double Number(const YAML::Node& node, const std::string& field) const {
-    if (!node) Fail(field, "missing");
-    double value = 0.0;
-    try {
-      value = node.as<double>();
-    } catch (const YAML::Exception&) {
-      Fail(field, "must be a number");
-    }
-    if (!std::isfinite(value)) Fail(field, "must be finite");
-    return value;
-  }
-  double NumberOr(const YAML::Node& map, const std::string& key, const std::string& where, double fallback) const {
-    return map[key] ? Number(map[key], where + "." + key) : fallback;
-  }
-  std::pair<double, double> Range(const YAML::Node& map, const std::string& key, const std::string& where,
-                                  std::pair<double, double> fallback) const {
-    const YAML::Node node = map[key];
-    if (!node) return fallback;
-    const std::string field = where + "." + key;
-    if (!node.IsSequence() || node.size() != 2) Fail(field, "must be [low, high]");
-    const double lo = Number(node[0], field + "[0]"), hi = Number(node[1], field + "[1]");
-    if (!(lo <= hi)) Fail(field, "low must not exceed high");
-    return {lo, hi};
-  }
-  std::string Resolve(const std::string& relative) const {
-    std::filesystem::path p(relative);
-    if (p.is_relative()) p = std::filesystem::path(path_).parent_path() / p;
-    return p.lexically_normal().string();
-  }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
+using SceneReader = YamlFieldReader;
 
 struct Placement {
   double omega_deg, azimuth_deg, distance_mm, roll_deg, tilt_x_deg, tilt_y_deg;
@@ -116,19 +68,11 @@ void PlaceTarget(const Sensor& sensor, const CalibrationTarget& target, double o
 
 Scene LoadSceneYaml(const std::string& path) {
   const SceneReader reader(path);
-  if (!std::filesystem::exists(path)) reader.Fail("", "file not found");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::ParserException& error) {
-    reader.Fail("line " + std::to_string(error.mark.line + 1), "malformed YAML: " + error.msg);
-  } catch (const YAML::Exception& error) {
-    reader.Fail("", std::string("cannot read: ") + error.what());
-  }
+  const YAML::Node root = reader.LoadFile();
   Scene scene;
   scene.path = path;
   try {
-    reader.RejectUnknown(root, "(top level)", {"sensor", "render", "environment", "targets", "views", "random_views"});
+    reader.RejectUnknown(root, "", {"sensor", "render", "environment", "targets", "views", "random_views"});
     // Sensor: a file, or the sensor's sections inline.
     const YAML::Node sensor = root["sensor"];
     if (!sensor) reader.Fail("sensor", "missing (a sensor file, or camera/mirror/pose inline)");

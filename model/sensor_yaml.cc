@@ -1,6 +1,5 @@
 // Sensor file reader and writer (yaml-cpp). Every field is checked; an unknown field is
 // an error too, because a misspelt optional key would otherwise be silently ignored.
-#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <cstdio>
@@ -12,98 +11,14 @@
 #include "model/atomic_write.h"
 #include "model/input_error.h"
 #include "model/sensor.h"
+#include "model/yaml_field_reader.h"
 
 namespace omnical {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
 
-class FieldReader {
- public:
-  explicit FieldReader(std::string path) : path_(std::move(path)) {}
-
-  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
-    throw InputError(InputMessage(path_, field, problem));
-  }
-
-  YAML::Node Section(const YAML::Node& root, const std::string& name) const {
-    const YAML::Node node = root[name];
-    if (!node) Fail(name, "missing section");
-    if (!node.IsMap()) Fail(name, "must be a map of fields");
-    return node;
-  }
-
-  void RejectUnknown(const YAML::Node& map, const std::string& section, const std::set<std::string>& known) const {
-    for (const auto& entry : map) {
-      const std::string key = entry.first.as<std::string>();
-      if (!known.count(key)) {
-        std::string list;
-        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-        Fail(section + "." + key, "unknown field (expected one of: " + list + ")");
-      }
-    }
-  }
-
-  double Number(const YAML::Node& node, const std::string& field) const {
-    if (!node) Fail(field, "missing");
-    if (!node.IsScalar()) Fail(field, "must be a number");
-    double value = 0.0;
-    try {
-      value = node.as<double>();
-    } catch (const YAML::Exception&) {
-      Fail(field, "'" + node.Scalar() + "' is not a number");
-    }
-    if (!std::isfinite(value)) Fail(field, "must be finite");
-    return value;
-  }
-  double Number(const YAML::Node& map, const std::string& key, const std::string& section) const {
-    return Number(map[key], section + "." + key);
-  }
-  double NumberOr(const YAML::Node& map, const std::string& key, const std::string& section, double fallback) const {
-    return map[key] ? Number(map[key], section + "." + key) : fallback;
-  }
-  // Strictly positive and below an upper bound that keeps the geometry representable
-  // (squares and products of lengths must not overflow a double).
-  double Positive(const YAML::Node& map, const std::string& key, const std::string& section,
-                  double max_value = 1e6) const {
-    const double value = Number(map, key, section);
-    if (!(value > 0.0)) Fail(section + "." + key, "must be > 0 (got " + Format(value) + ")");
-    if (!(value <= max_value)) Fail(section + "." + key, "must be <= " + Format(max_value) + " (got " + Format(value) + ")");
-    return value;
-  }
-  double Bounded(const YAML::Node& node, const std::string& field, double limit) const {
-    const double value = Number(node, field);
-    if (!(std::abs(value) <= limit)) Fail(field, "magnitude must be <= " + Format(limit) + " (got " + Format(value) + ")");
-    return value;
-  }
-  std::vector<double> Numbers(const YAML::Node& node, const std::string& field, size_t min_count,
-                              size_t max_count) const {
-    if (!node.IsSequence()) Fail(field, "must be a list of numbers");
-    if (node.size() < min_count || node.size() > max_count) {
-      Fail(field, min_count == max_count ? "must list " + std::to_string(min_count) + " numbers"
-                                         : "must list " + std::to_string(min_count) + " to " +
-                                               std::to_string(max_count) + " numbers");
-    }
-    std::vector<double> values;
-    for (size_t i = 0; i < node.size(); ++i) values.push_back(Number(node[i], field + "[" + std::to_string(i) + "]"));
-    return values;
-  }
-  std::string Text(const YAML::Node& map, const std::string& key, const std::string& section) const {
-    const YAML::Node node = map[key];
-    if (!node) Fail(section + "." + key, "missing");
-    if (!node.IsScalar()) Fail(section + "." + key, "must be a string");
-    return node.Scalar();
-  }
-  static std::string Format(double value) {
-    std::ostringstream out;
-    out << value;
-    return out.str();
-  }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
+using FieldReader = YamlFieldReader;
 
 struct LensChoice {
   PinholeLens<double> pinhole{};
@@ -116,7 +31,7 @@ struct LensChoice {
 LensChoice ReadCamera(const FieldReader& reader, const YAML::Node& root) {
   const YAML::Node camera = reader.Section(root, "camera");
   LensChoice lens;
-  const std::string model = reader.Text(camera, "model", "camera");
+  const std::string model = reader.Text(camera["model"], "camera.model");
   const YAML::Node size = camera["image_size"];
   if (!size) reader.Fail("camera.image_size", "missing");
   const std::vector<double> wh = reader.Numbers(size, "camera.image_size", 2, 2);
@@ -130,8 +45,8 @@ LensChoice ReadCamera(const FieldReader& reader, const YAML::Node& root) {
   if (model == "pinhole") {
     reader.RejectUnknown(camera, "camera", {"model", "image_size", "fx", "fy", "cx", "cy", "k1", "k2", "body_radius_mm"});
     PinholeLens<double>& p = lens.pinhole;
-    p.fx_px = reader.Positive(camera, "fx", "camera", 1e8);
-    p.fy_px = reader.Positive(camera, "fy", "camera", 1e8);
+    p.fx_px = reader.Positive(camera["fx"], "camera.fx", 1e8);
+    p.fy_px = reader.Positive(camera["fy"], "camera.fy", 1e8);
     if (p.fx_px < 1e-3 || p.fy_px < 1e-3) reader.Fail("camera.fx", "focal lengths below 1e-3 px are not a camera");
     p.cx_px = reader.Bounded(camera["cx"], "camera.cx", 1e7);
     p.cy_px = reader.Bounded(camera["cy"], "camera.cy", 1e7);
@@ -140,7 +55,7 @@ LensChoice ReadCamera(const FieldReader& reader, const YAML::Node& root) {
   } else if (model == "orthographic") {
     reader.RejectUnknown(camera, "camera", {"model", "image_size", "scale_px_per_mm", "cx", "cy", "body_radius_mm"});
     lens.is_orthographic = true;
-    lens.orthographic.scale_px_per_mm = reader.Positive(camera, "scale_px_per_mm", "camera", 1e6);
+    lens.orthographic.scale_px_per_mm = reader.Positive(camera["scale_px_per_mm"], "camera.scale_px_per_mm", 1e6);
     lens.orthographic.cx_px = reader.Bounded(camera["cx"], "camera.cx", 1e7);
     lens.orthographic.cy_px = reader.Bounded(camera["cy"], "camera.cy", 1e7);
   } else {
@@ -153,7 +68,7 @@ MirrorPose<double> ReadPose(const FieldReader& reader, const YAML::Node& root) {
   const YAML::Node pose = reader.Section(root, "pose");
   reader.RejectUnknown(pose, "pose", {"m", "tilt_deg", "decenter_mm"});
   MirrorPose<double> out{};
-  out.m_mm = reader.Positive(pose, "m", "pose");
+  out.m_mm = reader.Positive(pose["m"], "pose.m", 1e6);
   if (pose["tilt_deg"]) {
     const std::vector<double> tilt = reader.Numbers(pose["tilt_deg"], "pose.tilt_deg", 2, 2);
     for (double t : tilt)
@@ -196,12 +111,12 @@ SensorModel Assemble(const Profile<double>& profile, const LensChoice& lens, con
 SensorModel ReadMirror(const FieldReader& reader, const YAML::Node& root, const LensChoice& lens,
                        const MirrorPose<double>& pose) {
   const YAML::Node mirror = reader.Section(root, "mirror");
-  const std::string profile = reader.Text(mirror, "profile", "mirror");
-  const double rim = reader.Positive(mirror, "rim_radius", "mirror", 1e5);
+  const std::string profile = reader.Text(mirror["profile"], "mirror.profile");
+  const double rim = reader.Positive(mirror["rim_radius"], "mirror.rim_radius", 1e5);
   if (rim < 1e-3) reader.Fail("mirror.rim_radius", "must be >= 1e-3 mm");
   if (profile == "sphere") {
     reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "A"});
-    return Assemble(SphereProfile<double>{reader.Positive(mirror, "A", "mirror", 1e7)}, lens, pose, rim);
+    return Assemble(SphereProfile<double>{reader.Positive(mirror["A"], "mirror.A", 1e7)}, lens, pose, rim);
   }
   if (profile == "polynomial") {
     reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "coefficients"});
@@ -212,17 +127,17 @@ SensorModel ReadMirror(const FieldReader& reader, const YAML::Node& root, const 
   }
   if (profile == "hyperboloid") {
     reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "A", "B"});
-    return Assemble(HyperboloidProfile<double>{reader.Positive(mirror, "A", "mirror", 1e7),
-                                               reader.Positive(mirror, "B", "mirror", 1e7)},
+    return Assemble(HyperboloidProfile<double>{reader.Positive(mirror["A"], "mirror.A", 1e7),
+                                               reader.Positive(mirror["B"], "mirror.B", 1e7)},
                     lens, pose, rim);
   }
   if (profile == "paraboloid") {
     reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "A"});
-    return Assemble(ParaboloidProfile<double>{reader.Positive(mirror, "A", "mirror", 1e7)}, lens, pose, rim);
+    return Assemble(ParaboloidProfile<double>{reader.Positive(mirror["A"], "mirror.A", 1e7)}, lens, pose, rim);
   }
   if (profile == "tabulated") {
     reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "table"});
-    std::filesystem::path table = reader.Text(mirror, "table", "mirror");
+    std::filesystem::path table = reader.Text(mirror["table"], "mirror.table");
     if (table.is_relative()) table = std::filesystem::path(reader.path()).parent_path() / table;
     TabulatedProfile<double> tabulated;
     tabulated.source = std::filesystem::weakly_canonical(table).string();
@@ -340,7 +255,7 @@ Sensor SensorFromRoot(const YAML::Node& root, const FieldReader& reader) {
   const std::string& path = reader.path();
   if (!root.IsMap()) reader.Fail("", "expected a map with camera, mirror and pose sections");
   try {
-    reader.RejectUnknown(root, "(top level)", {"camera", "mirror", "pose"});
+    reader.RejectUnknown(root, "", {"camera", "mirror", "pose"});
     const LensChoice lens = ReadCamera(reader, root);
     const MirrorPose<double> pose = ReadPose(reader, root);
     SensorModel model = ReadMirror(reader, root, lens, pose);
@@ -355,16 +270,7 @@ Sensor SensorFromRoot(const YAML::Node& root, const FieldReader& reader) {
 
 Sensor LoadSensorYaml(const std::string& path) {
   const FieldReader reader(path);
-  if (!std::filesystem::exists(path)) reader.Fail("", "file not found");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::ParserException& error) {
-    reader.Fail("line " + std::to_string(error.mark.line + 1), "malformed YAML: " + error.msg);
-  } catch (const YAML::Exception& error) {
-    reader.Fail("", std::string("cannot read: ") + error.what());
-  }
-  return SensorFromRoot(root, reader);
+  return SensorFromRoot(reader.LoadFile(), reader);
 }
 
 Sensor ParseSensorYaml(const std::string& yaml_text, const std::string& source) {

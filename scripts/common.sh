@@ -37,8 +37,9 @@ configure_and_build() {
   cmake --build "$build_dir" -j "$jobs"
 }
 
-# The demo tree: Release, no tests or benchmarks (demo.sh and figures.sh).
+# The demo tree: Release, no tests or benchmarks; sets $omnical to the CLI binary.
 prepare_demo_build() {
   install_dependencies
   configure_and_build -DOMNICAL_BUILD_TESTS=OFF -DOMNICAL_BUILD_BENCHMARKS=OFF
+  omnical="$build_dir/tools/omnical"
 }

@@ -11,7 +11,6 @@ set -euo pipefail
 omnical_build_kind=demo
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 prepare_demo_build
-omnical="$build_dir/tools/omnical"
 out=${1:-$omnical_root/demo-out}
 mkdir -p "$out"
 "$omnical" render --scene "$omnical_root/datasets-synthetic/scenes/ohte-sph-near.yaml" --out "$out/render-ohte-sph-near"

@@ -7,7 +7,6 @@ set -euo pipefail
 omnical_build_kind=demo
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 prepare_demo_build
-omnical="$build_dir/tools/omnical"
 out="$omnical_root/docs/figures"
 for mirror in ohte-sph ohte-edi ohte-svp; do
   sensor="$omnical_root/datasets-synthetic/sensors/$mirror.yaml"

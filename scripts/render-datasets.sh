@@ -8,7 +8,6 @@ set -euo pipefail
 omnical_build_kind=demo
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 prepare_demo_build
-omnical="$build_dir/tools/omnical"
 scenes="$omnical_root/datasets-synthetic/scenes"
 if [ "${1:-}" = "--large" ]; then
   out="$omnical_root/build/datasets-large"
