@@ -1,0 +1,36 @@
+// Detected target corners per image: what `omnical detect` writes and `omnical
+// calibrate` reads (JSON). A rendered view's ground truth converts to the same form.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace omnical {
+
+struct CornerObservation {
+  int id;                 // the target's corner id (calib/target.h)
+  Eigen::Vector2d pixel;  // u = column, v = row; pixel (0, 0) has its centre at (0, 0)
+};
+
+struct ImageDetections {
+  std::string image;  // path as given to detect
+  std::vector<CornerObservation> corners;
+};
+
+struct DetectionSet {
+  std::string target_spec;  // the spec file the ids refer to
+  int image_width_px = 0, image_height_px = 0;
+  std::vector<ImageDetections> images;
+};
+
+// JSON: {"target": spec, "image_size": [W, H], "images": [{"image": path,
+// "corners": [{"id": i, "pixel": [u, v]}, ...]}, ...]}. Read throws InputError naming the
+// file and the entry; write is atomic.
+DetectionSet ReadDetections(const std::string& path);
+void WriteDetections(const DetectionSet& detections, const std::string& path);
+
+// The visible corners of rendered views (omnical render's <view>.json files).
+DetectionSet DetectionsFromGroundTruth(const std::vector<std::string>& truth_paths);
+
+}  // namespace omnical
