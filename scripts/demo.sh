@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds omnical in Release and runs the main job on the bundled
-# synthetic data. Today: (0) render the near-target scene of the spherical mirror
-# (8 views, with ground truth); then for each of the seed paper's three mirrors, (1) the sensor model:
+# synthetic data. Today: (0) the main job on a misaligned spherical mirror: render 8 views
+# with ground truth, detect the aprilgrid, calibrate from the design guess, parallax report
+# of the result; then for each of the seed paper's three mirrors, (1) the sensor model:
 # unproject a pixel grid to rays, put objects 7 mirror radii away along them (the paper's
 # near case) and project them back exactly; (2) the paper's optics evaluation
-# (characterize); (3) the parallax report for objects at n = 7 (parallax). The remaining
-# stages (detect -> calibrate -> remap export) join as their issues land.
+# (characterize); (3) the parallax report for objects at n = 7 (parallax). Remap export
+# joins as its issue lands.
 # Output: demo-out/ (or $1).
 set -euo pipefail
 omnical_build_kind=demo
@@ -13,7 +14,15 @@ source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 prepare_demo_build
 out=${1:-$omnical_root/demo-out}
 mkdir -p "$out"
-"$omnical" render --scene "$omnical_root/datasets-synthetic/scenes/ohte-sph-near.yaml" --out "$out/render-ohte-sph-near"
+# The main job on a misaligned sensor: render its near-target views, detect the tags,
+# calibrate from the nominal design guess, then the parallax report of the calibrated sensor.
+"$omnical" render --scene "$omnical_root/datasets-synthetic/scenes/ohte-sph-misaligned-near.yaml" --out "$out/render"
+"$omnical" detect --target "$omnical_root/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml" --images "$out/render" \
+  --out "$out/detections.json"
+"$omnical" calibrate --target "$omnical_root/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml" \
+  --detections "$out/detections.json" --sensor "$omnical_root/datasets-synthetic/sensors/ohte-sph-misaligned-guess.yaml" \
+  --out "$out/calibration"
+"$omnical" parallax --sensor "$out/calibration/sensor.yaml" --n 7 --out "$out/calibration/parallax-n7"
 
 for mirror in ohte-sph ohte-edi ohte-svp; do
   sensor="$omnical_root/datasets-synthetic/sensors/$mirror.yaml"

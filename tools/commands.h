@@ -13,9 +13,12 @@ Command CharacterizeCommand();
 Command ParallaxCommand();
 Command TargetCommand();
 Command RenderCommand();
+Command DetectCommand();
+Command CalibrateCommand();
 
 inline std::vector<Command> AllCommands() {
-  return {ProjectCommand(), UnprojectCommand(), CharacterizeCommand(), ParallaxCommand(), TargetCommand(), RenderCommand()};
+  return {ProjectCommand(), UnprojectCommand(), CharacterizeCommand(), ParallaxCommand(), TargetCommand(),
+          RenderCommand(),  DetectCommand(),    CalibrateCommand()};
 }
 
 }  // namespace omnical::cli

@@ -190,5 +190,66 @@ expect_error render_unreadable "scene_bad.yaml: line" -- render --scene "$work/s
 expect_error render_missing "nope.yaml: file not found" -- render --scene "$work/nope.yaml" --out "$work/out.csv"
 expect_error target_zero_size "zero.yaml: tagSize: must be > 0" -- target --spec "$work/zero.yaml" --out "$work/out.png"
 
+# --- detect and calibrate (the committed renders of the misaligned sphere) ---------------
+rendered=$source_dir/datasets-synthetic/rendered/ohte-sph-misaligned-near
+grid=$targets/aprilgrid-6x6-30mm.yaml
+guess=$sensors/ohte-sph-misaligned-guess.yaml
+if "$omnical" -q detect --target "$grid" --images "$rendered" --out "$work/det.json"; then
+  # Against the ground truth: recall of visible corners and pixel error (raw AprilTag:
+  # 96.9% and 0.26 px RMS measured; the bounds leave room, not slack for regressions).
+  python3 - "$work/det.json" <<'PYCHECK' && pass || fail "detect accuracy"
+import json, math, sys
+det = json.load(open(sys.argv[1]))
+errors, found, visible = [], 0, 0
+for image in det["images"]:
+    truth = {c["id"]: c for c in json.load(open(image["image"][:-4] + ".json"))["targets"][0]["corners"]}
+    ids = {c["id"] for c in image["corners"]}
+    visible += sum(c["visible"] for c in truth.values())
+    found += sum(truth[i]["visible"] for i in ids)
+    errors += [math.dist(c["pixel"], truth[c["id"]]["pixel"]) for c in image["corners"]]
+rms = math.sqrt(sum(e * e for e in errors) / len(errors))
+print(f"detect: recall {found / visible:.3f}, RMS {rms:.3f} px")
+sys.exit(0 if found / visible > 0.95 and rms < 0.35 else 1)
+PYCHECK
+else
+  fail "detect exited $?"
+fi
+if "$omnical" -q calibrate --target "$grid" --detections "$work/det.json" --sensor "$guess" --out "$work/cal"; then
+  near "$(json "$work/cal/calibration.json" rms_px)" 0.15 0.15 "calibrate RMS (px)"
+  [ "$(json "$work/cal/calibration.json" converged)" = True ] && pass || fail "calibrate did not converge"
+  [ -s "$work/cal/sensor.yaml" ] && [ -s "$work/cal/report/residual_histogram.png" ] && [ -s "$work/cal/report/coverage.png" ] &&
+    [ -s "$work/cal/report/per_view_rms.png" ] && [ -s "$work/cal/report/residuals_view0.png" ] && pass || fail "calibrate outputs"
+  "$omnical" project --sensor "$work/cal/sensor.yaml" --points "$work/points.csv" >/dev/null && pass || fail "calibrated sensor.yaml does not load"
+else
+  fail "calibrate exited $?"
+fi
+# Bad input: nothing may be written.
+python3 - "$work/det.json" "$work" <<'PYBAD'
+import json, sys
+det = json.load(open(sys.argv[1])); work = sys.argv[2]
+two = dict(det); two["images"] = det["images"][:2]; json.dump(two, open(work + "/det_two.json", "w"))
+same = dict(det); same["images"] = [det["images"][0]] * 4; json.dump(same, open(work + "/det_same.json", "w"))
+size = dict(det); size["image_size"] = [1000, 1000]; json.dump(size, open(work + "/det_size.json", "w"))
+PYBAD
+printf 'target_type: aprilgrid\ntagCols: 6\ntagRows: 6\ntagSize: 0.03\ntagSpacing: 0.3\ncodeOffset: 200\n' >"$work/other_ids.yaml"
+calibrate_error() {
+  local name=$1 expected=$2
+  shift 2
+  rm -rf "$work/cal_bad"
+  expect_error "$name" "$expected" -- calibrate --sensor "$guess" --out "$work/cal_bad" "$@"
+  [ ! -e "$work/cal_bad" ] && pass || fail "$name: left $work/cal_bad behind"
+}
+calibrate_error calibrate_too_few_views "too few" --target "$grid" --detections "$work/det_two.json"
+calibrate_error calibrate_one_pose "all views show the target at one pose" --target "$grid" --detections "$work/det_same.json"
+calibrate_error calibrate_spec_matches_nothing "matches no corner id" --target "$work/other_ids.yaml" --detections "$work/det.json"
+calibrate_error calibrate_image_size "image_size: 1000 x 1000 differs from the sensor's 1040 x 1040" --target "$grid" --detections "$work/det_size.json"
+calibrate_error calibrate_unknown_block "--fix: unknown block 'focal'" --target "$grid" --detections "$work/det.json" --fix focal
+# A corrupt image is reported and skipped; the others are detected.
+mkdir -p "$work/mixed" && cp "$rendered/near-front.png" "$rendered/near000.png" "$work/mixed/" && printf 'not a png' >"$work/mixed/broken.png"
+"$omnical" -q detect --target "$grid" --images "$work/mixed" --out "$work/mixed.json" 2>"$work/stderr" &&
+  grep -q "broken.png: cannot read the image, skipped" "$work/stderr" &&
+  [ "$(python3 -c "import json,sys; print(len(json.load(open(sys.argv[1]))['images']))" "$work/mixed.json")" = 2 ] && pass ||
+  fail "detect with a corrupt image"
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -1,0 +1,215 @@
+// omnical calibrate: the bundle fit of the non-central model from detections and a
+// sensor guess -> sensor.yaml, calibration.json and a report of PNG figures. Everything is
+// checked and computed before anything is written.
+#include <nlohmann/json.hpp>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "calib/bundle_fit.h"
+#include "model/atomic_write.h"
+#include "model/input_error.h"
+#include "tools/commands.h"
+#include "tools/plot.h"
+
+namespace omnical::cli {
+namespace {
+
+struct Options {
+  std::string target_path, detections_path, sensor_path, out_dir, fix;
+  double loss_px = 1.0;
+  int max_iterations = 200;
+};
+
+std::set<std::string> SplitList(const std::string& text) {
+  std::set<std::string> items;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ','))
+    if (!item.empty()) items.insert(item);
+  return items;
+}
+
+void WriteReport(const std::filesystem::path& dir, const DetectionSet& detections, const FitResult& fit) {
+  std::filesystem::create_directories(dir);
+  double worst = 0.0;
+  std::vector<double> magnitudes;
+  for (const auto& view : fit.residuals_px)
+    for (const Eigen::Vector2d& r : view)
+      if (std::isfinite(r.x())) magnitudes.push_back(r.norm()), worst = std::max(worst, r.norm());
+  // Residual vectors on each image, scaled so the largest is ~40 px long.
+  const double scale = worst > 0.0 ? std::pow(10.0, std::floor(std::log10(40.0 / worst))) : 1.0;
+  cv::Mat coverage(detections.image_height_px, detections.image_width_px, CV_8UC3, cv::Scalar(30, 30, 30));
+  for (size_t v = 0; v < detections.images.size(); ++v) {
+    const ImageDetections& image = detections.images[v];
+    cv::Mat picture = cv::imread(image.image, cv::IMREAD_COLOR);
+    if (picture.empty()) picture = cv::Mat(detections.image_height_px, detections.image_width_px, CV_8UC3, cv::Scalar(40, 40, 40));
+    for (size_t i = 0; i < image.corners.size(); ++i) {
+      const cv::Point2d p(image.corners[i].pixel.x(), image.corners[i].pixel.y());
+      cv::circle(coverage, p, 2, SeriesColor(static_cast<int>(v)), cv::FILLED);
+      const Eigen::Vector2d& r = fit.residuals_px[v][i];
+      if (!std::isfinite(r.x())) {
+        cv::drawMarker(picture, p, cv::Scalar(0, 0, 255), cv::MARKER_TILTED_CROSS, 8, 1);  // dropped
+        continue;
+      }
+      cv::circle(picture, p, 2, cv::Scalar(0, 200, 0), cv::FILLED);
+      cv::line(picture, p, p + cv::Point2d(r.x(), r.y()) * scale, cv::Scalar(0, 140, 255), 1, cv::LINE_AA);
+    }
+    char legend[160];
+    std::snprintf(legend, sizeof legend, "residuals x%g (orange), RMS %.3f px; red crosses: dropped", scale,
+                  fit.per_view_rms_px[v]);
+    cv::putText(picture, legend, {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+    WritePng((dir / ("residuals_view" + std::to_string(v) + ".png")).string(), picture);
+  }
+  cv::putText(coverage, "detected corners, one colour per view", {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.6,
+              cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  WritePng((dir / "coverage.png").string(), coverage);
+
+  // Histogram of residual magnitudes and per-view RMS, drawn as steps.
+  const int bins = 30;
+  const double width = worst > 0.0 ? worst / bins : 1.0;
+  std::vector<double> counts(bins, 0.0);
+  for (double m : magnitudes) counts[std::min(bins - 1, static_cast<int>(m / width))] += 1.0;
+  std::vector<double> x, y;
+  for (int b = 0; b < bins; ++b) {
+    x.insert(x.end(), {b * width, b * width, (b + 1) * width, (b + 1) * width});
+    y.insert(y.end(), {0.0, counts[b], counts[b], 0.0});
+  }
+  PlotPanel histogram("Residual magnitudes", "|residual| (px)", "corners");
+  histogram.series.push_back(PlotSeries("", x, y, SeriesColor(0)));
+  WritePng((dir / "residual_histogram.png").string(), RenderPanel(histogram, 800, 500));
+  x.clear(), y.clear();
+  for (size_t v = 0; v < fit.per_view_rms_px.size(); ++v) {
+    x.insert(x.end(), {v - 0.4, v - 0.4, v + 0.4, v + 0.4});
+    y.insert(y.end(), {0.0, fit.per_view_rms_px[v], fit.per_view_rms_px[v], 0.0});
+  }
+  PlotPanel per_view("RMS reprojection error per view", "view", "RMS (px)");
+  per_view.series.push_back(PlotSeries("", x, y, SeriesColor(1)));
+  WritePng((dir / "per_view_rms.png").string(), RenderPanel(per_view, 800, 500));
+}
+
+void Run(const Options& options, const Context& context) {
+  const CalibrationTarget target = CalibrationTarget::FromYaml(options.target_path);
+  DetectionSet detections = ReadDetections(options.detections_path);
+  const Sensor guess = LoadSensorYaml(options.sensor_path);
+  if (detections.image_width_px != guess.image_width_px() || detections.image_height_px != guess.image_height_px())
+    throw InputError(InputMessage(options.detections_path, "image_size",
+                                  std::to_string(detections.image_width_px) + " x " + std::to_string(detections.image_height_px) +
+                                      " differs from the sensor's " + std::to_string(guess.image_width_px()) + " x " +
+                                      std::to_string(guess.image_height_px())));
+  FitOptions fit_options = FitOptions::DefaultsFor(guess);
+  for (const std::string& name : SplitList(options.fix)) fit_options.fixed.insert(name);
+  fit_options.robust_loss_px = options.loss_px;
+  fit_options.max_iterations = options.max_iterations;
+  if (const std::string why = fit_options.Check(); !why.empty()) throw InputError(why);
+
+  // Views: known ids only, at least 4 corners, and a pose through the guess.
+  std::set<int> ids;
+  for (const TargetCorner& c : target.corners()) ids.insert(c.id);
+  int matched = 0;
+  for (ImageDetections& image : detections.images) {
+    image.corners.erase(std::remove_if(image.corners.begin(), image.corners.end(),
+                                       [&](const CornerObservation& c) { return !ids.count(c.id); }),
+                        image.corners.end());
+    matched += static_cast<int>(image.corners.size());
+  }
+  if (matched == 0)
+    throw InputError(InputMessage(options.target_path, "", "the target spec matches no corner id in " + options.detections_path));
+  DetectionSet usable = detections;
+  usable.images.clear();
+  std::vector<TargetPose> poses;
+  for (const ImageDetections& image : detections.images) {
+    TargetPose pose;
+    if (image.corners.size() < 4 || !InitialTargetPose(guess, target, image, &pose)) {
+      if (!context.quiet) std::fprintf(stderr, "omnical: warning: %s: too few usable corners, view skipped\n", image.image.c_str());
+      continue;
+    }
+    usable.images.push_back(image);
+    poses.push_back(pose);
+  }
+  // Enough data for what is asked: 2 residuals per corner against 6 per view plus the
+  // sensor's free parameters, and views that differ (one pose says nothing about the
+  // mirror).
+  int observations = 0;
+  for (const ImageDetections& image : usable.images) observations += static_cast<int>(image.corners.size());
+  const int sensor_parameters = static_cast<int>(SensorParameters(guess).size());
+  if (usable.images.size() < 3 || 2 * observations < 2 * (6 * static_cast<int>(usable.images.size()) + sensor_parameters))
+    throw InputError(InputMessage(options.detections_path, "images",
+                                  std::to_string(usable.images.size()) + " usable views with " + std::to_string(observations) +
+                                      " corners are too few for the " + std::to_string(sensor_parameters) +
+                                      " sensor parameters (need >= 3 views)"));
+  double spread_deg = 0.0, spread_mm = 0.0;
+  for (const TargetPose& pose : poses) {
+    spread_deg = std::max(spread_deg, pose.camera_from_target_rotation.angularDistance(poses[0].camera_from_target_rotation) * 180.0 / M_PI);
+    spread_mm = std::max(spread_mm, (pose.camera_from_target_translation_mm - poses[0].camera_from_target_translation_mm).norm());
+  }
+  if (spread_deg < 1.0 && spread_mm < 5.0)
+    throw InputError(InputMessage(options.detections_path, "images", "all views show the target at one pose: move it between images"));
+
+  const FitResult fit = FitSensor(guess, target, usable, poses, fit_options);
+  if (!fit.sensor) throw InputError(InputMessage(options.detections_path, "", "the fit failed: " + fit.solver_report));
+  const std::string why_invalid = ValidateSensorModel(fit.sensor->model());
+
+  nlohmann::json result;
+  result["rms_px"] = fit.rms_px;
+  result["converged"] = fit.converged;
+  result["outliers"] = fit.outliers;
+  result["dropped"] = fit.dropped;
+  result["observations"] = fit.observations;
+  result["solver_report"] = fit.solver_report;
+  result["fixed_blocks"] = fit_options.fixed;
+  result["robust_loss_px"] = fit_options.robust_loss_px;
+  result["covariance_ok"] = fit.covariance_ok;
+  if (!why_invalid.empty()) result["warning"] = "the fitted sensor fails validation: " + why_invalid;
+  for (size_t v = 0; v < usable.images.size(); ++v) result["per_view_rms_px"][usable.images[v].image] = fit.per_view_rms_px[v];
+  for (const ParameterEstimate& p : fit.parameters)
+    result["parameters"][p.name] = {{"value", p.value}, {"std", p.std}, {"fixed", p.fixed}};
+  for (size_t v = 0; v < usable.images.size(); ++v) {
+    const TargetPose& pose = fit.poses[v];
+    const Eigen::Quaterniond& q = pose.camera_from_target_rotation;
+    result["poses"][usable.images[v].image] = {
+        {"camera_from_target_quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}},
+        {"camera_from_target_translation_mm",
+         {pose.camera_from_target_translation_mm.x(), pose.camera_from_target_translation_mm.y(),
+          pose.camera_from_target_translation_mm.z()}}};
+  }
+
+  const std::filesystem::path dir(options.out_dir);
+  std::filesystem::create_directories(dir);
+  SaveSensorYaml(*fit.sensor, (dir / "sensor.yaml").string());
+  WriteFileAtomically((dir / "calibration.json").string(), [&](std::ostream& out) { out << result.dump(2) << '\n'; });
+  WriteReport(dir / "report", usable, fit);
+  if (!context.quiet) {
+    std::printf("%zu views, %d corners: RMS %.4f px, %s; -> %s\n", usable.images.size(), observations, fit.rms_px,
+                fit.converged ? "converged" : "NOT converged", options.out_dir.c_str());
+    for (const ParameterEstimate& p : fit.parameters)
+      std::printf("  %-16s %14.8g %s\n", p.name.c_str(), p.value,
+                  p.fixed ? "(fixed)" : ("+- " + std::to_string(p.std)).c_str());
+  }
+}
+
+}  // namespace
+
+Command CalibrateCommand() {
+  return {"calibrate", "Bundle fit of the non-central model from detections and a sensor guess",
+          [](CLI::App& sub, const Context& context) -> CommandAction {
+            auto options = std::make_shared<Options>();
+            sub.add_option("--target", options->target_path, "Target spec (YAML, Kalibr keys)")->required();
+            sub.add_option("--detections", options->detections_path, "Detections (JSON, from omnical detect)")->required();
+            sub.add_option("--sensor", options->sensor_path, "Sensor guess (YAML): nominal design values")->required();
+            sub.add_option("--out", options->out_dir, "Output directory")->required();
+            sub.add_option("--fix", options->fix, "Blocks held constant: lens, lens_scale, m, tilt, decenter, shape, poses");
+            sub.add_option("--loss-px", options->loss_px, "Huber loss scale, px (0: least squares)")
+                ->check(CLI::Range(0.0, 1000.0))->capture_default_str();
+            sub.add_option("--max-iterations", options->max_iterations, "Solver iterations per stage")
+                ->check(CLI::Range(1, 100000))->capture_default_str();
+            return [options, &context]() { Run(*options, context); };
+          }};
+}
+
+}  // namespace omnical::cli
