@@ -2,8 +2,11 @@
 
 #include <ceres/ceres.h>
 
+#include <Eigen/SVD>
+
 #include <opencv2/calib3d.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -125,12 +128,18 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
-  std::unique_ptr<ceres::LossFunction> loss;
-  if (options.robust_loss_px > 0.0) loss = std::make_unique<ceres::HuberLoss>(options.robust_loss_px);
+  // Robust mode: a redescending Cauchy loss while far from the solution (gross outliers get
+  // almost no weight, where Huber's linear influence would still pull), then the outliers
+  // are removed and the last solve uses Huber. The wrapper swaps the loss of every residual.
+  std::unique_ptr<ceres::LossFunctionWrapper> loss;
+  if (options.robust_loss_px > 0.0)
+    loss = std::make_unique<ceres::LossFunctionWrapper>(new ceres::CauchyLoss(options.robust_loss_px), ceres::TAKE_OWNERSHIP);
   struct Residual {
     size_t view, index;
     std::unique_ptr<Cost> functor;  // a copy kept to evaluate plain residuals afterwards
     std::vector<double*> blocks;
+    ceres::ResidualBlockId id;
+    bool outlier = false;
   };
   std::vector<Residual> residuals;
   result.residuals_px.resize(views);
@@ -163,8 +172,8 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
       cost->AddParameterBlock(4);
       cost->AddParameterBlock(3);
       cost->SetNumResiduals(2);
-      problem.AddResidualBlock(cost, loss.get(), blocks);
-      residuals.push_back({v, i, std::make_unique<Cost>(cost_template), blocks});
+      const ceres::ResidualBlockId id = problem.AddResidualBlock(cost, loss.get(), blocks);
+      residuals.push_back({v, i, std::make_unique<Cost>(cost_template), blocks, id});
     }
   }
   if (residuals.empty()) {
@@ -181,6 +190,10 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
   if (options.fixed.count("lens_scale")) held_scale = LensD::kIsOrthographic ? std::vector<int>{0} : std::vector<int>{0, 1};
   std::vector<int> distortion;
   if constexpr (!LensD::kIsOrthographic) distortion = {4, 5};
+  if (options.fixed.count("distortion")) {  // held throughout, like the scale
+    held_scale.insert(held_scale.end(), distortion.begin(), distortion.end());
+    distortion.clear();
+  }
   auto set_lens = [&](bool hold_distortion) {
     if (lens_fixed) {
       problem.SetParameterBlockConstant(lens.data());
@@ -242,11 +255,36 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
   }
   set_lens(false);
   ceres::Solve(solver, &problem, &summary);
+  // Gross outliers (robust mode): residuals beyond 5 sigma, with sigma from the median
+  // residual (a 2-D Gaussian's |e| has median 1.1774 sigma; P(|e| > 5 sigma) = 4e-6), are
+  // removed and the fit repeated without them, under Huber.
+  if (options.robust_loss_px > 0.0) {
+    std::vector<double> norms;
+    for (const Residual& r : residuals) {
+      double value[2];
+      if ((*r.functor)(r.blocks.data(), value)) norms.push_back(std::hypot(value[0], value[1]));
+    }
+    if (!norms.empty()) {
+      std::nth_element(norms.begin(), norms.begin() + norms.size() / 2, norms.end());
+      const double threshold = 5.0 * norms[norms.size() / 2] / 1.1774;
+      for (Residual& r : residuals) {
+        double value[2];
+        if (!(*r.functor)(r.blocks.data(), value) || std::hypot(value[0], value[1]) > threshold) {
+          r.outlier = true;
+          ++result.outliers;
+          problem.RemoveResidualBlock(r.id);
+        }
+      }
+    }
+    loss->Reset(new ceres::HuberLoss(options.robust_loss_px), ceres::TAKE_OWNERSHIP);
+    ceres::Solve(solver, &problem, &summary);
+  }
   result.converged = summary.termination_type == ceres::CONVERGENCE;
   result.solver_report = summary.BriefReport();
 
-  // Plain residuals at the solution.
+  // Plain residuals at the solution; the statistics are over the inliers.
   double sum = 0.0;
+  int inliers = 0;
   std::vector<double> view_sum(views, 0.0);
   std::vector<int> view_count(views, 0);
   for (const Residual& r : residuals) {
@@ -254,50 +292,67 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
     if (!(*r.functor)(r.blocks.data(), value)) continue;
     const Eigen::Vector2d e(value[0], value[1]);
     result.residuals_px[r.view][r.index] = e;
+    if (r.outlier) continue;
     sum += e.squaredNorm();
+    ++inliers;
     view_sum[r.view] += e.squaredNorm();
     ++view_count[r.view];
-    if (options.robust_loss_px > 0.0 && e.norm() > 3.0 * options.robust_loss_px) ++result.outliers;
   }
-  result.rms_px = std::sqrt(sum / residuals.size());
+  result.rms_px = std::sqrt(sum / std::max(1, inliers));
   for (size_t v = 0; v < views; ++v)
     result.per_view_rms_px.push_back(view_count[v] ? std::sqrt(view_sum[v] / view_count[v]) : NAN);
 
-  // Standard deviations: ceres::Covariance of the free sensor blocks, scaled by the
-  // residual variance (the fit does not know the detection noise).
-  std::vector<std::pair<const double*, int>> sensor_blocks = {{lens.data(), static_cast<int>(lens.size())},
-                                                              {&m_mm, 1}, {tilt, 2}, {decenter, 2}};
-  if (!shape.empty()) sensor_blocks.push_back({shape.data(), static_cast<int>(shape.size())});
-  std::map<const double*, Eigen::MatrixXd> covariance;
+  // Standard deviations: (J^T J)^-1 at the solution, scaled by the residual variance
+  // (the fit does not know the detection noise). The Jacobian's columns differ by many
+  // orders of magnitude (a polynomial's c3 multiplies r^6), so they are scaled to unit
+  // norm before the inversion: ceres::Covariance's truncated SVD would otherwise discard
+  // well-determined directions and report their variance as zero.
+  std::map<const double*, Eigen::VectorXd> variances;  // per free sensor block, ambient order
   if (options.compute_covariance) {
-    ceres::Covariance::Options covariance_options;
-    covariance_options.algorithm_type = ceres::DENSE_SVD;
-    covariance_options.null_space_rank = -1;  // a degenerate direction gives a large std, not a failure
-    ceres::Covariance estimator(covariance_options);
-    std::vector<std::pair<const double*, const double*>> pairs;
-    for (const auto& [block, size] : sensor_blocks)
-      if (!problem.IsParameterBlockConstant(const_cast<double*>(block))) pairs.emplace_back(block, block);
-    if (estimator.Compute(pairs, &problem)) {
-      result.covariance_ok = true;
-      const int free_parameters = problem.NumParameters() - [&] {
-        int constant = 0;
-        std::vector<double*> all;
-        problem.GetParameterBlocks(&all);
-        for (double* b : all) {
-          if (problem.IsParameterBlockConstant(b)) {
-            constant += problem.ParameterBlockSize(b);
-          } else if (problem.HasManifold(b)) {
-            constant += problem.ParameterBlockSize(b) - problem.ParameterBlockTangentSize(b);
+    std::vector<double*> variable;
+    std::vector<double*> all;
+    problem.GetParameterBlocks(&all);
+    for (double* b : all)
+      if (!problem.IsParameterBlockConstant(b)) variable.push_back(b);
+    ceres::Problem::EvaluateOptions evaluate;
+    evaluate.parameter_blocks = variable;
+    evaluate.apply_loss_function = false;
+    ceres::CRSMatrix crs;
+    problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
+    Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+    for (int r = 0; r < crs.num_rows; ++r)
+      for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) jacobian(r, crs.cols[k]) = crs.values[k];
+    Eigen::VectorXd column_scale = jacobian.colwise().norm().transpose();
+    const bool all_seen = (column_scale.array() > 0.0).all();
+    if (all_seen) {
+      const Eigen::MatrixXd scaled = jacobian * column_scale.cwiseInverse().asDiagonal();
+      const Eigen::JacobiSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeThinV);
+      const Eigen::VectorXd& sigma = svd.singularValues();
+      // Rank check on the scaled problem: a real degeneracy (a gauge left free) shows here.
+      if (sigma.minCoeff() > 1e-10 * sigma.maxCoeff()) {
+        result.covariance_ok = true;
+        const Eigen::MatrixXd v = svd.matrixV() * sigma.cwiseInverse().asDiagonal();
+        const Eigen::VectorXd scaled_variance = v.rowwise().squaredNorm();
+        const double residual_variance = sum / std::max(1, 2 * inliers - crs.num_cols);
+        int column = 0;
+        for (double* b : variable) {
+          const int tangent = problem.ParameterBlockTangentSize(b), size = problem.ParameterBlockSize(b);
+          Eigen::VectorXd block = Eigen::VectorXd::Zero(size);
+          // Tangent coordinates: all of the block, or (lens with held scale) the free entries in order.
+          std::vector<int> free;
+          for (int k = 0; k < size; ++k) free.push_back(k);
+          if (b == lens.data() && tangent < size) {
+            free.clear();
+            for (int k = 0; k < size; ++k)
+              if (std::find(held_scale.begin(), held_scale.end(), k) == held_scale.end()) free.push_back(k);
           }
+          if (static_cast<int>(free.size()) == tangent) {
+            for (int t = 0; t < tangent; ++t)
+              block(free[t]) = scaled_variance(column + t) / (column_scale(column + t) * column_scale(column + t)) * residual_variance;
+            variances[b] = block;
+          }
+          column += tangent;
         }
-        return constant;
-      }();
-      const double variance = sum / std::max(1, 2 * static_cast<int>(residuals.size()) - free_parameters);
-      for (const auto& [a, b] : pairs) {
-        const int size = problem.ParameterBlockSize(const_cast<double*>(a));
-        Eigen::MatrixXd block(size, size);
-        estimator.GetCovarianceBlock(a, b, block.data());
-        covariance[a] = block * variance;
       }
     }
   }
@@ -306,13 +361,16 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
     estimate.name = name;
     estimate.value = block[index] * scale;
     estimate.fixed = problem.IsParameterBlockConstant(const_cast<double*>(block));  // after stage 2: as asked
-    const auto found = covariance.find(block);
-    if (found != covariance.end()) estimate.std = std::sqrt(std::max(0.0, found->second(index, index))) * scale;
+    const auto found = variances.find(block);
+    if (found != variances.end()) estimate.std = std::sqrt(std::max(0.0, found->second(index))) * scale;
+    if (!estimate.fixed && !result.covariance_ok) estimate.std = NAN;  // undetermined: say so
     result.parameters.push_back(estimate);
   };
   ForEachParameter<LensD, ProfileD>(lens.data(), &m_mm, tilt, decenter, shape.data(), shape_count, add);
   if (options.fixed.count("lens_scale") && !options.fixed.count("lens"))
     for (size_t k = 0; k < (LensD::kIsOrthographic ? 1u : 2u); ++k) result.parameters[k].fixed = true, result.parameters[k].std = 0.0;
+  if (options.fixed.count("distortion") && !options.fixed.count("lens") && !LensD::kIsOrthographic)
+    for (size_t k = 4; k < 6; ++k) result.parameters[k].fixed = true, result.parameters[k].std = 0.0;
 
   Model fitted = guess;
   fitted.lens = LensD::FromParams(lens.data());
@@ -371,14 +429,19 @@ FitOptions FitOptions::DefaultsFor(const Sensor& sensor) {
   // A sphere turned about its own centre is the same surface (only its rim moves): its
   // tilt is not observable; its centre, R (0, 0, A) + (dx, dy, m), is.
   if (std::string(sensor.profile_name()) == "sphere") options.fixed.insert("tilt");
+  // A free polynomial mirror bends the radial mapping as the lens's radial distortion
+  // does: k1, k2 are held and the mirror shape absorbs them. (Its fx is observable but
+  // weakly: another fx with another polynomial looks almost the same; see the README.)
+  if (std::string(sensor.profile_name()) == "polynomial" && std::string(sensor.lens_name()) == "pinhole")
+    options.fixed.insert("distortion");
   return options;
 }
 
 std::string FitOptions::Check() const {
-  static const std::set<std::string> kBlocks = {"lens", "lens_scale", "m", "tilt", "decenter", "shape", "poses"};
+  static const std::set<std::string> kBlocks = {"lens", "lens_scale", "distortion", "m", "tilt", "decenter", "shape", "poses"};
   for (const std::string& name : fixed)
     if (!kBlocks.count(name))
-      return "--fix: unknown block '" + name + "' (lens, lens_scale, m, tilt, decenter, shape, poses)";
+      return "--fix: unknown block '" + name + "' (lens, lens_scale, distortion, m, tilt, decenter, shape, poses)";
   if (!(robust_loss_px >= 0.0)) return "--loss-px: must be >= 0";
   if (max_iterations < 1) return "--max-iterations: must be >= 1";
   return {};

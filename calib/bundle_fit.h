@@ -14,6 +14,8 @@
 // leaves one scale free (pixel scale x mirror size); FitOptions::DefaultsFor fixes m,
 // decenter and the lens scale for it. A spherical mirror turned about its own centre is
 // the same surface, so its tilt is not observable (its centre is): the defaults fix it.
+// A free polynomial mirror and the lens's radial distortion bend the same radial mapping:
+// the defaults hold k1, k2 and let the mirror shape absorb them.
 #pragma once
 
 #include <Eigen/Core>
@@ -30,8 +32,8 @@
 namespace omnical {
 
 struct FitOptions {
-  std::set<std::string> fixed;  // block names: lens, lens_scale, m, tilt, decenter, shape, poses
-  double robust_loss_px = 1.0;  // Huber scale in px; 0 = plain least squares
+  std::set<std::string> fixed;  // block names: lens, lens_scale, distortion (k1, k2), m, tilt, decenter, shape, poses
+  double robust_loss_px = 1.0;  // robust scale in px (Cauchy, outlier removal, then Huber); 0 = plain least squares
   int max_iterations = 200;
   bool compute_covariance = true;
 
@@ -49,7 +51,7 @@ struct TargetPose {
 struct ParameterEstimate {
   std::string name;  // with its unit: fx_px, m_mm, tilt_x_deg, ...
   double value = 0.0;
-  double std = 0.0;  // from ceres::Covariance, scaled by the residual variance; 0 if fixed
+  double std = 0.0;  // from (J^T J)^-1 scaled by the residual variance; 0 if fixed, NaN if undetermined
   bool fixed = false;
 };
 
@@ -57,12 +59,12 @@ struct FitResult {
   std::optional<Sensor> sensor;
   std::vector<TargetPose> poses;
   std::vector<ParameterEstimate> parameters;
-  double rms_px = 0.0;
+  double rms_px = 0.0;  // per corner, over the inliers
   std::vector<double> per_view_rms_px;
   // Residual (observed - predicted... as fitted: predicted - observed) per view, per corner
   // in the order of the detections; NaN where the corner was dropped.
   std::vector<std::vector<Eigen::Vector2d>> residuals_px;
-  int outliers = 0;  // residuals beyond 3 robust-loss scales at the end
+  int outliers = 0;  // gross outliers removed (robust mode: beyond 5 sigma from the median residual)
   int dropped = 0;   // observations not projectable at the initial guess
   int observations = 0;
   bool converged = false;

@@ -4,6 +4,9 @@
 #include <apriltag/tag36h11.h>
 #include <apriltag/tagStandard41h12.h>
 
+#include <opencv2/calib3d.hpp>
+
+#include <algorithm>
 #include <map>
 #include <stdexcept>
 
@@ -58,6 +61,31 @@ ImageDetections DetectAprilGrid(const CalibrationTarget& target, const cv::Mat& 
   }
   if (stats) *stats = local;
   return image;
+}
+
+ImageDetections DetectCheckerboard(const CalibrationTarget& target, const cv::Mat& grey) {
+  if (target.type() != CalibrationTarget::Type::kCheckerboard)
+    throw std::invalid_argument("not a checkerboard target");
+  cv::Mat flipped;
+  cv::flip(grey, flipped, 1);  // undo the mirror's reversal of handedness
+  std::vector<cv::Point2f> corners;
+  ImageDetections image;
+  if (!cv::findChessboardCornersSB(flipped, cv::Size(target.cols(), target.rows()), corners,
+                                   cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY))
+    return image;
+  for (int i = 0; i < static_cast<int>(corners.size()); ++i) {
+    const int row_down = i / target.cols(), col = i % target.cols();
+    const int id = (target.rows() - 1 - row_down) * target.cols() + col;  // rows counted upwards
+    image.corners.push_back({id, Eigen::Vector2d(grey.cols - 1 - corners[i].x, corners[i].y)});
+  }
+  std::sort(image.corners.begin(), image.corners.end(),
+            [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; });
+  return image;
+}
+
+ImageDetections DetectTarget(const CalibrationTarget& target, const cv::Mat& grey) {
+  return target.type() == CalibrationTarget::Type::kAprilGrid ? DetectAprilGrid(target, grey)
+                                                               : DetectCheckerboard(target, grey);
 }
 
 }  // namespace omnical

@@ -3,8 +3,13 @@
 // corners are mapped back. Tag corner k of AprilTag's detection is the board's corner k
 // (calib/target.h; Kalibr's order), checked on a printed board in tests/detect_test.cc.
 //
+// Checkerboards: OpenCV's findChessboardCornersSB (EXHAUSTIVE | ACCURACY) on the flipped
+// image. Its row-major order is read with rows counted upwards, which makes the id
+// assignment a proper rotation of the board; a checkerboard's corner set maps onto itself
+// under the remaining 180 deg ambiguity, so a fit is unaffected by it.
+//
 // Not yet: re-detection in virtual perspective views through a sensor guess (for tags
-// near the rim), sub-pixel refinement beyond AprilTag's edge refinement, checkerboards.
+// near the rim), sub-pixel refinement beyond the detectors' own.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -23,7 +28,14 @@ struct DetectionStats {
 };
 
 // Detects the target's tags in an 8-bit grey image (pixel-centre coordinates, as
-// everywhere). Throws std::invalid_argument for a target type it cannot detect yet.
+// everywhere). Throws std::invalid_argument for another target type.
 ImageDetections DetectAprilGrid(const CalibrationTarget& target, const cv::Mat& grey, DetectionStats* stats = nullptr);
+
+// The checkerboard's inner corners, all or none. Throws std::invalid_argument for
+// another target type.
+ImageDetections DetectCheckerboard(const CalibrationTarget& target, const cv::Mat& grey);
+
+// Either, by the target's type.
+ImageDetections DetectTarget(const CalibrationTarget& target, const cv::Mat& grey);
 
 }  // namespace omnical

@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -165,10 +166,31 @@ void Run(const Options& options, const Context& context) {
   result["fixed_blocks"] = fit_options.fixed;
   result["robust_loss_px"] = fit_options.robust_loss_px;
   result["covariance_ok"] = fit.covariance_ok;
-  if (!why_invalid.empty()) result["warning"] = "the fitted sensor fails validation: " + why_invalid;
+  std::vector<std::string> warnings;
+  if (!why_invalid.empty()) warnings.push_back("the fitted sensor fails validation: " + why_invalid);
+  if (!fit.converged) warnings.push_back("the solver did not converge: " + fit.solver_report);
+  if (!fit.covariance_ok) warnings.push_back("the parameters are not all determined by the data (a free gauge): fix one with --fix");
+  // Weakly determined: the "dolly zoom" between fx and m is the usual one (the lens sees
+  // the mirror under a small angle); fixing m from the design or fx from the lens helps.
+  // Only scale-like parameters have a meaningful relative std (tilts, decenters, the
+  // principal point and distortion are naturally near zero).
+  auto scale_like = [](const std::string& name) {
+    return name == "fx_px" || name == "fy_px" || name == "scale_px_per_mm" || name == "m_mm" || name == "A_mm" ||
+           name == "B_mm" || (name.size() >= 2 && name[0] == 'c' && std::isdigit(static_cast<unsigned char>(name[1])));
+  };
+  for (const ParameterEstimate& p : fit.parameters)
+    if (!p.fixed && scale_like(p.name) && std::isfinite(p.std) && p.value != 0.0 && p.std > 0.05 * std::abs(p.value))
+      warnings.push_back(p.name + " is weakly determined (std " + std::to_string(100.0 * p.std / std::abs(p.value)) +
+                         (p.name == "fx_px" || p.name == "fy_px" || p.name == "m_mm"
+                              ? "% of its value): fx and m trade off; fix m from the design (--fix m) or the lens scale, "
+                                "or add views at more distances"
+                              : "% of its value): views covering more of the mirror, at more distances, help"));
+  result["warnings"] = warnings;
   for (size_t v = 0; v < usable.images.size(); ++v) result["per_view_rms_px"][usable.images[v].image] = fit.per_view_rms_px[v];
   for (const ParameterEstimate& p : fit.parameters)
-    result["parameters"][p.name] = {{"value", p.value}, {"std", p.std}, {"fixed", p.fixed}};
+    result["parameters"][p.name] = {{"value", p.value},
+                                    {"std", std::isfinite(p.std) ? nlohmann::json(p.std) : nlohmann::json(nullptr)},
+                                    {"fixed", p.fixed}};
   for (size_t v = 0; v < usable.images.size(); ++v) {
     const TargetPose& pose = fit.poses[v];
     const Eigen::Quaterniond& q = pose.camera_from_target_rotation;
@@ -184,12 +206,17 @@ void Run(const Options& options, const Context& context) {
   SaveSensorYaml(*fit.sensor, (dir / "sensor.yaml").string());
   WriteFileAtomically((dir / "calibration.json").string(), [&](std::ostream& out) { out << result.dump(2) << '\n'; });
   WriteReport(dir / "report", usable, fit);
+  for (const std::string& w : warnings) std::fprintf(stderr, "omnical: warning: %s\n", w.c_str());
   if (!context.quiet) {
     std::printf("%zu views, %d corners: RMS %.4f px, %s; -> %s\n", usable.images.size(), observations, fit.rms_px,
                 fit.converged ? "converged" : "NOT converged", options.out_dir.c_str());
-    for (const ParameterEstimate& p : fit.parameters)
-      std::printf("  %-16s %14.8g %s\n", p.name.c_str(), p.value,
-                  p.fixed ? "(fixed)" : ("+- " + std::to_string(p.std)).c_str());
+    for (const ParameterEstimate& p : fit.parameters) {
+      if (p.fixed) {
+        std::printf("  %-16s %14.8g (fixed)\n", p.name.c_str(), p.value);
+      } else {
+        std::printf("  %-16s %14.8g +- %.3g\n", p.name.c_str(), p.value, p.std);
+      }
+    }
   }
 }
 
@@ -203,7 +230,7 @@ Command CalibrateCommand() {
             sub.add_option("--detections", options->detections_path, "Detections (JSON, from omnical detect)")->required();
             sub.add_option("--sensor", options->sensor_path, "Sensor guess (YAML): nominal design values")->required();
             sub.add_option("--out", options->out_dir, "Output directory")->required();
-            sub.add_option("--fix", options->fix, "Blocks held constant: lens, lens_scale, m, tilt, decenter, shape, poses");
+            sub.add_option("--fix", options->fix, "Blocks held constant: lens, lens_scale, distortion, m, tilt, decenter, shape, poses");
             sub.add_option("--loss-px", options->loss_px, "Huber loss scale, px (0: least squares)")
                 ->check(CLI::Range(0.0, 1000.0))->capture_default_str();
             sub.add_option("--max-iterations", options->max_iterations, "Solver iterations per stage")

@@ -1,4 +1,5 @@
-// omnical detect: the target's corners in omni images (AprilTag 3 on the mirrored image),
+// omnical detect: the target's corners in omni images (AprilTag 3 or OpenCV's
+// checkerboard detector on the mirrored image),
 // parallel over images; unreadable images are reported and skipped.
 #include <glob.h>
 
@@ -44,7 +45,7 @@ std::vector<std::string> ListImages(const std::string& where) {
 }  // namespace
 
 Command DetectCommand() {
-  return {"detect", "Detect the target's corners in omni images -> detections.json (AprilTag grids)",
+  return {"detect", "Detect the target's corners in omni images -> detections.json (aprilgrid or checkerboard)",
           [](CLI::App& sub, const Context& context) -> CommandAction {
             auto spec = std::make_shared<std::string>();
             auto images = std::make_shared<std::string>();
@@ -56,8 +57,6 @@ Command DetectCommand() {
             sub.add_option("--threads", *threads, "Worker threads")->check(CLI::Range(1, 256))->capture_default_str();
             return [=, &context]() {
               const CalibrationTarget target = CalibrationTarget::FromYaml(*spec);
-              if (target.type() != CalibrationTarget::Type::kAprilGrid)
-                throw InputError(InputMessage(*spec, "target_type", "detect handles aprilgrid targets so far"));
               const std::vector<std::string> paths = ListImages(*images);
               std::vector<ImageDetections> found(paths.size());
               std::vector<cv::Size> sizes(paths.size());
@@ -72,7 +71,7 @@ Command DetectCommand() {
                       problems[i] = "cannot read the image";
                     } else {
                       sizes[i] = grey.size();
-                      found[i] = DetectAprilGrid(target, grey);
+                      found[i] = DetectTarget(target, grey);
                       found[i].image = paths[i];
                     }
                     progress.Advance();
@@ -103,7 +102,7 @@ Command DetectCommand() {
               if (set.images.empty()) throw InputError(InputMessage(*images, "--images", "no readable image"));
               WriteDetections(set, *out);
               if (!context.quiet)
-                std::printf("%zu images, %d corners (%d tags) -> %s\n", set.images.size(), corners, corners / 4, out->c_str());
+                std::printf("%zu images, %d corners -> %s\n", set.images.size(), corners, out->c_str());
             };
           }};
 }

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   std::map<CLI::App*, cli::CommandAction> actions;
   for (const cli::Command& command : cli::AllCommands()) {
     CLI::App* sub = app.add_subcommand(command.name, command.summary);
+    sub->fallthrough();  // -q/--quiet also after the subcommand
     actions[sub] = command.add(*sub, context);
   }
   try {
