@@ -9,6 +9,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <algorithm>
 #include <map>
 #include <sstream>
 
@@ -25,6 +26,7 @@ struct Options {
   std::string target_path, detections_path, sensor_path, out_dir, fix;
   double loss_px = 1.0;
   int max_iterations = 200;
+  bool leave_one_out = false;
 };
 
 std::set<std::string> SplitList(const std::string& text) {
@@ -166,6 +168,30 @@ void Run(const Options& options, const Context& context) {
   result["fixed_blocks"] = fit_options.fixed;
   result["robust_loss_px"] = fit_options.robust_loss_px;
   result["covariance_ok"] = fit.covariance_ok;
+  // Stability: the fit repeated without each image in turn; the spread of each parameter.
+  if (options.leave_one_out) {
+    std::map<std::string, std::vector<double>> folds;
+    FitOptions quick = fit_options;
+    quick.compute_covariance = false;
+    for (size_t left_out = 0; left_out < usable.images.size(); ++left_out) {
+      DetectionSet subset = usable;
+      std::vector<TargetPose> subset_poses = poses;
+      subset.images.erase(subset.images.begin() + left_out);
+      subset_poses.erase(subset_poses.begin() + left_out);
+      const FitResult fold = FitSensor(guess, target, subset, subset_poses, quick);
+      for (const ParameterEstimate& p : fold.parameters) folds[p.name].push_back(p.value);
+      if (!context.quiet) std::fprintf(stderr, "\rleave-one-out: %zu/%zu", left_out + 1, usable.images.size());
+    }
+    if (!context.quiet) std::fputc('\n', stderr);
+    for (const auto& [name, values] : folds) {
+      const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+      double mean = 0.0, square = 0.0;
+      for (double v : values) mean += v;
+      mean /= values.size();
+      for (double v : values) square += (v - mean) * (v - mean);
+      result["leave_one_out"][name] = {{"min", *lo}, {"max", *hi}, {"std", std::sqrt(square / values.size())}};
+    }
+  }
   std::vector<std::string> warnings;
   if (!why_invalid.empty()) warnings.push_back("the fitted sensor fails validation: " + why_invalid);
   if (!fit.converged) warnings.push_back("the solver did not converge: " + fit.solver_report);
@@ -235,6 +261,8 @@ Command CalibrateCommand() {
                 ->check(CLI::Range(0.0, 1000.0))->capture_default_str();
             sub.add_option("--max-iterations", options->max_iterations, "Solver iterations per stage")
                 ->check(CLI::Range(1, 100000))->capture_default_str();
+            sub.add_flag("--leave-one-out", options->leave_one_out,
+                         "Also fit without each image in turn; calibration.json gets each parameter's spread");
             return [options, &context]() { Run(*options, context); };
           }};
 }

@@ -208,7 +208,10 @@ cv::Mat RenderFalseColourMap(const cv::Mat& values, const std::string& title, co
 
 void WritePng(const std::string& path, const cv::Mat& image) {
   std::vector<uchar> bytes;
-  if (!cv::imencode(".png", image, bytes, {cv::IMWRITE_PNG_COMPRESSION, 9})) throw InputError(InputMessage(path, "", "cannot encode PNG"));
+  // Small figures compress hard (they are committed under docs/); large images (report
+  // overlays of whole camera frames) fast.
+  const int level = image.total() > 1000000 ? 3 : 9;
+  if (!cv::imencode(".png", image, bytes, {cv::IMWRITE_PNG_COMPRESSION, level})) throw InputError(InputMessage(path, "", "cannot encode PNG"));
   WriteFileAtomically(path, [&](std::ostream& out) { out.write(reinterpret_cast<const char*>(bytes.data()), bytes.size()); });
 }
 

@@ -223,6 +223,10 @@ if "$omnical" -q calibrate --target "$grid" --detections "$work/det.json" --sens
 else
   fail "calibrate exited $?"
 fi
+# Leave-one-image-out: one spread per parameter.
+"$omnical" -q calibrate --target "$grid" --detections "$work/det.json" --sensor "$guess" --out "$work/cal_loo" --leave-one-out 2>/dev/null &&
+  python3 -c "import json,sys; d=json.load(open(sys.argv[1])); l=d['leave_one_out']; sys.exit(0 if set(l) == set(d['parameters']) and l['fx_px']['max'] >= l['fx_px']['min'] else 1)" "$work/cal_loo/calibration.json" &&
+  pass || fail "calibrate --leave-one-out"
 # Bad input: nothing may be written.
 python3 - "$work/det.json" "$work" <<'PYBAD'
 import json, sys
