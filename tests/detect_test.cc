@@ -9,13 +9,14 @@
 #include <algorithm>
 
 #include "calib/detect.h"
+#include "test_sensors.h"
 
 namespace omnical {
 namespace {
 
 TEST(DetectAprilGrid, FindsEveryTagOfAMirroredPrintInPlace) {
   const CalibrationTarget grid = CalibrationTarget::AprilGrid(4, 3, 25.0, 0.3, "tag36h11", 5);
-  const std::string path = ::testing::TempDir() + "/mirrored_grid.png";
+  const std::string path = testing::PrivateTempDir() + "/mirrored_grid.png";
   const double dpi = 150.0;
   grid.WritePng(path, dpi);
   cv::Mat print = cv::imread(path, cv::IMREAD_GRAYSCALE), mirrored;
@@ -47,7 +48,7 @@ TEST(DetectAprilGrid, FindsEveryTagOfAMirroredPrintInPlace) {
 
 TEST(DetectAprilGrid, RejectsTagsTheTargetDoesNotHave) {
   const CalibrationTarget printed = CalibrationTarget::AprilGrid(2, 2, 25.0, 0.3, "tag36h11", 40);
-  const std::string path = ::testing::TempDir() + "/other_grid.png";
+  const std::string path = testing::PrivateTempDir() + "/other_grid.png";
   printed.WritePng(path, 150.0);
   cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
   cv::flip(image, image, 1);

@@ -78,7 +78,7 @@ TEST(TabulatedProfile, RejectsBadTables) {
   EXPECT_THROW(CubicSplineInR2({0.0, 1.0, 1.0, 2.0}, {0, 1, 1, 2}), std::invalid_argument);  // r not increasing
   EXPECT_THROW(CubicSplineInR2({0.5, 1.0, 1.5, 2.0}, {0, 1, 1, 2}), std::invalid_argument);  // no vertex row
   EXPECT_THROW(CubicSplineInR2({0.0, 1.0}, {0, 1}), std::invalid_argument);                  // too few rows
-  const std::string path = ::testing::TempDir() + "/bad_profile.csv";
+  const std::string path = testing::PrivateTempDir() + "/bad_profile.csv";
   std::ofstream(path) << "r,z\n0,0\n1,0.1\nabc,0.2\n";
   try {
     LoadProfileTable(path);

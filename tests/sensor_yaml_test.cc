@@ -13,7 +13,7 @@ namespace omnical {
 namespace {
 
 std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "/" + name;
+  const std::string path = testing::PrivateTempDir() + "/" + name;
   std::ofstream(path) << text;
   return path;
 }
@@ -32,7 +32,7 @@ TEST(SensorYaml, LoadsTheShippedSensors) {
 TEST(SensorYaml, SaveThenLoadIsLossless) {
   // The tabulated profile needs its table on disk.
   const TabulatedProfile<double> sampled = testing::SampledEdiProfile();
-  const std::string table_path = ::testing::TempDir() + "/sampled_edi.csv";
+  const std::string table_path = testing::PrivateTempDir() + "/sampled_edi.csv";
   {
     std::ofstream table(table_path);
     table.precision(17);
@@ -49,7 +49,7 @@ TEST(SensorYaml, SaveThenLoadIsLossless) {
         },
         named.model);
     const Sensor original(named.model);
-    const std::string path = ::testing::TempDir() + "/saved_sensor.yaml";
+    const std::string path = testing::PrivateTempDir() + "/saved_sensor.yaml";
     SaveSensorYaml(original, path);
     const Sensor loaded = LoadSensorYaml(path);
     EXPECT_EQ(loaded.model().index(), original.model().index()) << named.name;

@@ -37,7 +37,7 @@ TEST(Target, PrintedAprilGridDecodesToItsIdsInPlace) {
   for (const char* family : {"tag36h11", "tagStandard41h12"}) {
     const CalibrationTarget grid =
         CalibrationTarget::AprilGrid(4, 3, 25.0, std::string(family) == "tag36h11" ? 0.3 : 1.0, family, 10);
-    const std::string path = ::testing::TempDir() + "/grid.png";
+    const std::string path = testing::PrivateTempDir() + "/grid.png";
     grid.WritePng(path, 100.0);
     cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(image.empty());
@@ -87,7 +87,7 @@ TEST(Target, BadSpecsAreRejectedWithTheField) {
        "targetCols: must be a whole number"},
   };
   for (const Case& c : cases) {
-    const std::string path = ::testing::TempDir() + "/bad_target.yaml";
+    const std::string path = testing::PrivateTempDir() + "/bad_target.yaml";
     std::ofstream(path) << c.text;
     try {
       CalibrationTarget::FromYaml(path);

@@ -3,7 +3,11 @@
 // pinhole), scaled so the rim images at about 480 px from the centre of a 1000 x 1000 image.
 #pragma once
 
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -84,5 +88,16 @@ inline std::vector<NamedSensor> AllTestSensors() {
 }
 
 inline std::string SourceDir() { return OMNICAL_SOURCE_DIR; }
+
+// A temporary directory of this process: ctest runs test cases as parallel processes,
+// so files with fixed names in the shared temp dir would race.
+inline std::string PrivateTempDir() {
+  static const std::string dir = [] {
+    const std::string path = ::testing::TempDir() + "/omnical-test-" + std::to_string(::getpid());
+    std::filesystem::create_directories(path);
+    return path;
+  }();
+  return dir;
+}
 
 }  // namespace omnical::testing
