@@ -1,12 +1,16 @@
 #include "calib/detect.h"
 
+#include <Eigen/Geometry>
 #include <apriltag/apriltag.h>
 #include <apriltag/tag36h11.h>
 #include <apriltag/tagStandard41h12.h>
 
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <map>
 #include <stdexcept>
 
@@ -81,6 +85,130 @@ ImageDetections DetectCheckerboard(const CalibrationTarget& target, const cv::Ma
   std::sort(image.corners.begin(), image.corners.end(),
             [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; });
   return image;
+}
+
+namespace {
+
+// AprilTag detections (corners in the given image's pixel-centre coordinates, no flip).
+std::map<int, std::array<Eigen::Vector2d, 4>> DetectTags(const CalibrationTarget& target, const cv::Mat& image) {
+  apriltag_family_t* family = target.family() == "tag36h11" ? tag36h11_create() : tagStandard41h12_create();
+  apriltag_detector_t* detector = apriltag_detector_create();
+  apriltag_detector_add_family(detector, family);
+  detector->quad_decimate = 1.0f;
+  detector->nthreads = 1;
+  detector->refine_edges = true;
+  cv::Mat continuous = image.isContinuous() ? image : image.clone();
+  image_u8_t frame{continuous.cols, continuous.rows, static_cast<int32_t>(continuous.step), continuous.data};
+  zarray_t* detections = apriltag_detector_detect(detector, &frame);
+  const int first = target.code_offset(), last = first + target.cols() * target.rows() - 1;
+  std::map<int, std::array<Eigen::Vector2d, 4>> tags;
+  std::map<int, int> seen;
+  for (int i = 0; i < zarray_size(detections); ++i) {
+    apriltag_detection_t* d;
+    zarray_get(detections, i, &d);
+    if (d->id < first || d->id > last || ++seen[d->id] > 1) continue;
+    std::array<Eigen::Vector2d, 4> corners;
+    for (int k = 0; k < 4; ++k) corners[k] = Eigen::Vector2d(d->p[k][0] - 0.5, d->p[k][1] - 0.5);
+    tags[d->id] = corners;
+  }
+  for (const auto& [id, count] : seen)
+    if (count > 1) tags.erase(id);
+  apriltag_detections_destroy(detections);
+  apriltag_detector_destroy(detector);
+  if (target.family() == "tag36h11") tag36h11_destroy(family); else tagStandard41h12_destroy(family);
+  return tags;
+}
+
+}  // namespace
+
+ImageDetections DetectThroughVirtualViews(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& guess,
+                                          const ImageDetections& raw) {
+  constexpr int kSize = 400;
+  const ProjectionCache& cache = guess.cache();
+  // Reference viewpoint on the axis and the omni image's angular scale (px per rad near
+  // the middle of the field), from the guess's axial analysis.
+  const double viewpoint_z = cache.guess.valid() ? cache.guess.reference_viewpoint_mm() : 0.0;
+  const Eigen::Vector3d centre = cache.camera_from_mirror_rotation * Eigen::Vector3d(0, 0, viewpoint_z) +
+                                 cache.camera_from_mirror_translation;
+  const double omni_px_per_rad = 0.5 * std::min(guess.image_width_px(), guess.image_height_px()) / 2.0;
+  const double focal = 2.0 * omni_px_per_rad;  // magnify ~2x
+  const double half_fov = std::atan(0.5 * kSize / focal);
+  struct Best {
+    std::array<Eigen::Vector2d, 4> corners;
+    double off_centre;
+  };
+  std::map<int, Best> best;
+  for (double omega = 40.0; omega <= 140.0; omega += 1.6 * half_fov * 180.0 / M_PI) {
+    const double omega_rad = omega * M_PI / 180.0;
+    const double step = 1.6 * half_fov / std::max(0.2, std::sin(omega_rad));
+    for (double azimuth = 0.0; azimuth < 2.0 * M_PI - 1e-9; azimuth += 2.0 * M_PI / std::ceil(2.0 * M_PI / step)) {
+      // The view looks outwards along (Omega, azimuth) of the mirror frame, image y down
+      // towards the mirror's -z (a proper rotation: no mirror reversal).
+      const Eigen::Vector3d forward_m(std::sin(omega_rad) * std::cos(azimuth), std::sin(omega_rad) * std::sin(azimuth),
+                                      -std::cos(omega_rad));
+      Eigen::Vector3d right_m = forward_m.cross(Eigen::Vector3d::UnitZ());
+      if (right_m.norm() < 1e-9) right_m = Eigen::Vector3d::UnitX();
+      right_m.normalize();
+      const Eigen::Vector3d down_m = forward_m.cross(right_m);
+      Eigen::Matrix3d view_to_mirror;
+      view_to_mirror << right_m, down_m, forward_m;
+      const Eigen::Matrix3d view_to_camera = cache.camera_from_mirror_rotation * view_to_mirror;
+      Eigen::Matrix3Xd far(3, kSize * kSize);
+      for (int j = 0; j < kSize; ++j)
+        for (int i = 0; i < kSize; ++i)
+          far.col(j * kSize + i) =
+              centre + 1e7 * (view_to_camera * Eigen::Vector3d((i - 0.5 * (kSize - 1)) / focal, (j - 0.5 * (kSize - 1)) / focal, 1.0)).normalized();
+      Eigen::Matrix2Xd pixels;
+      std::vector<ProjectionStatus> statuses;
+      guess.ProjectBatch(far, &pixels, &statuses);
+      cv::Mat map_x(kSize, kSize, CV_32F), map_y(kSize, kSize, CV_32F);
+      for (int k = 0; k < kSize * kSize; ++k) {
+        const bool ok = statuses[k] == ProjectionStatus::kOk;
+        map_x.at<float>(k / kSize, k % kSize) = ok ? static_cast<float>(pixels(0, k)) : -1.0f;
+        map_y.at<float>(k / kSize, k % kSize) = ok ? static_cast<float>(pixels(1, k)) : -1.0f;
+      }
+      cv::Mat view;
+      cv::remap(grey, view, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+      for (const auto& [id, corners] : DetectTags(target, view)) {
+        std::array<Eigen::Vector2d, 4> omni;
+        bool inside = true;
+        Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+        for (int k = 0; k < 4; ++k) {
+          const double x = corners[k].x(), y = corners[k].y();
+          const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+          if (x0 < 0 || y0 < 0 || x0 + 1 >= kSize || y0 + 1 >= kSize) {
+            inside = false;
+            break;
+          }
+          const double a = x - x0, b = y - y0;
+          auto interpolate = [&](const cv::Mat& map) {
+            return (1 - a) * (1 - b) * map.at<float>(y0, x0) + a * (1 - b) * map.at<float>(y0, x0 + 1) +
+                   (1 - a) * b * map.at<float>(y0 + 1, x0) + a * b * map.at<float>(y0 + 1, x0 + 1);
+          };
+          for (int dy = 0; dy < 2; ++dy)
+            for (int dx = 0; dx < 2; ++dx)
+              if (map_x.at<float>(y0 + dy, x0 + dx) < 0.0f) inside = false;
+          omni[k] = Eigen::Vector2d(interpolate(map_x), interpolate(map_y));
+          mean += corners[k] / 4.0;
+        }
+        if (!inside) continue;
+        const double off_centre = (mean - Eigen::Vector2d::Constant(0.5 * (kSize - 1))).norm();
+        const auto it = best.find(id);
+        if (it == best.end() || off_centre < it->second.off_centre) best[id] = {omni, off_centre};
+      }
+    }
+  }
+  ImageDetections out;
+  std::map<int, std::array<Eigen::Vector2d, 4>> merged;
+  for (size_t k = 0; k + 3 < raw.corners.size(); k += 4)
+    if (raw.corners[k].id % 4 == 0)
+      merged[raw.corners[k].id / 4] = {raw.corners[k].pixel, raw.corners[k + 1].pixel, raw.corners[k + 2].pixel,
+                                       raw.corners[k + 3].pixel};
+  for (const auto& [id, b] : best) merged[id] = b.corners;
+  for (const auto& [id, corners] : merged)
+    for (int k = 0; k < 4; ++k) out.corners.push_back({4 * id + k, corners[k]});
+  out.image = raw.image;
+  return out;
 }
 
 ImageDetections DetectTarget(const CalibrationTarget& target, const cv::Mat& grey) {

@@ -18,6 +18,7 @@
 
 #include "calib/detections.h"
 #include "calib/target.h"
+#include "model/sensor.h"
 
 namespace omnical {
 
@@ -37,5 +38,14 @@ ImageDetections DetectCheckerboard(const CalibrationTarget& target, const cv::Ma
 
 // Either, by the target's type.
 ImageDetections DetectTarget(const CalibrationTarget& target, const cv::Mat& grey);
+
+// AprilTag grids through virtual perspective views built with a sensor guess: a sweep of
+// pinhole views (magnified ~2x, from the mirror's reference viewpoint) resampled from the
+// omni image with maps of exact projections; tags are detected there (no mirror reversal
+// in a perspective view) and their corners mapped back through the same maps, so the
+// guess's error does not move them. Per tag, the view where it is most central wins;
+// tags found only in the omni image are kept from `raw`.
+ImageDetections DetectThroughVirtualViews(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& guess,
+                                          const ImageDetections& raw);
 
 }  // namespace omnical

@@ -18,7 +18,7 @@ mkdir -p "$out"
 # calibrate from the nominal design guess, then the parallax report of the calibrated sensor.
 "$omnical" render --scene "$omnical_root/datasets-synthetic/scenes/ohte-sph-misaligned-near.yaml" --out "$out/render"
 "$omnical" detect --target "$omnical_root/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml" --images "$out/render" \
-  --out "$out/detections.json"
+  --sensor "$omnical_root/datasets-synthetic/sensors/ohte-sph-misaligned-guess.yaml" --out "$out/detections.json"
 "$omnical" calibrate --target "$omnical_root/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml" \
   --detections "$out/detections.json" --sensor "$omnical_root/datasets-synthetic/sensors/ohte-sph-misaligned-guess.yaml" \
   --out "$out/calibration"

@@ -7,6 +7,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <map>
 
 #include "calib/detect.h"
 #include "test_sensors.h"
@@ -56,6 +58,36 @@ TEST(DetectAprilGrid, RejectsTagsTheTargetDoesNotHave) {
   const ImageDetections found = DetectAprilGrid(CalibrationTarget::AprilGrid(2, 2, 25.0, 0.3), image, &stats);
   EXPECT_TRUE(found.corners.empty());
   EXPECT_EQ(stats.wrong_ids, 4);
+}
+
+// Far targets (~14 px tags, 40 mirror radii away): raw AprilTag misses about a quarter;
+// through virtual views (the true sensor as the guess) nearly all are found, and more
+// accurately (measured over the whole far set: 73.6% -> 99.1%, 0.25 -> 0.13 px RMS).
+TEST(DetectThroughVirtualViews, FindsFarTagsTheRawDetectorMisses) {
+  const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/ohte-sph-far";
+  const DetectionSet truth = DetectionsFromGroundTruth({set + "/far000.json", set + "/far001.json"});
+  const CalibrationTarget target = CalibrationTarget::FromYaml(truth.target_spec);
+  const Sensor guess = LoadSensorYaml(set + "/sensor.yaml");
+  int visible = 0, raw_found = 0, found = 0;
+  double sum = 0.0;
+  for (const ImageDetections& view : truth.images) {
+    const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+    const ImageDetections raw = DetectTarget(target, grey);
+    const ImageDetections through = DetectThroughVirtualViews(target, grey, guess, raw);
+    std::map<int, Eigen::Vector2d> expected;
+    for (const CornerObservation& c : view.corners) expected[c.id] = c.pixel;
+    visible += static_cast<int>(expected.size());
+    for (const CornerObservation& c : raw.corners) raw_found += expected.count(c.id);
+    for (const CornerObservation& c : through.corners) {
+      const auto it = expected.find(c.id);
+      if (it == expected.end()) continue;
+      ++found;
+      sum += (c.pixel - it->second).squaredNorm();
+    }
+  }
+  EXPECT_GT(found, raw_found);
+  EXPECT_GE(found, 0.97 * visible);
+  EXPECT_LT(std::sqrt(sum / found), 0.2);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <iostream>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "calib/detect.h"
@@ -51,12 +52,17 @@ Command DetectCommand() {
             auto images = std::make_shared<std::string>();
             auto out = std::make_shared<std::string>();
             auto threads = std::make_shared<int>(static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+            auto sensor_path = std::make_shared<std::string>();
             sub.add_option("--target", *spec, "Target spec (YAML, Kalibr keys)")->required();
+            sub.add_option("--sensor", *sensor_path,
+                           "Sensor guess (YAML): re-detect aprilgrid tags in virtual perspective views through it");
             sub.add_option("--images", *images, "Directory of images, or a glob pattern (quote it)")->required();
             sub.add_option("--out", *out, "Detections file (JSON)")->required();
             sub.add_option("--threads", *threads, "Worker threads")->check(CLI::Range(1, 256))->capture_default_str();
             return [=, &context]() {
               const CalibrationTarget target = CalibrationTarget::FromYaml(*spec);
+              std::optional<Sensor> guess;
+              if (!sensor_path->empty()) guess = LoadSensorYaml(*sensor_path);
               const std::vector<std::string> paths = ListImages(*images);
               std::vector<ImageDetections> found(paths.size());
               std::vector<cv::Size> sizes(paths.size());
@@ -72,6 +78,9 @@ Command DetectCommand() {
                     } else {
                       sizes[i] = grey.size();
                       found[i] = DetectTarget(target, grey);
+                      if (guess && target.type() == CalibrationTarget::Type::kAprilGrid && grey.cols == guess->image_width_px() &&
+                          grey.rows == guess->image_height_px())
+                        found[i] = DetectThroughVirtualViews(target, grey, *guess, found[i]);
                       found[i].image = paths[i];
                     }
                     progress.Advance();
