@@ -34,6 +34,7 @@ void ProjectPointsBatch(const Model& model, const ProjectionCache& cache, const 
   alignas(64) double px[kBlock], py[kBlock], pz[kBlock], rho[kBlock];
   alignas(64) double qx[kBlock], qy[kBlock], last_step[kBlock], ahead[kBlock];
   alignas(64) double u[kBlock], v[kBlock], distance[kBlock];
+  alignas(64) double mirror_x[kBlock], mirror_y[kBlock], mirror_z[kBlock];  // camera frame
   for (long start = 0; start < count; start += kBlock) {
     const int n = static_cast<int>(std::min<long>(kBlock, count - start));
     const double* block = points_xyz + 3 * start;
@@ -74,6 +75,7 @@ void ProjectPointsBatch(const Model& model, const ProjectionCache& cache, const 
         Vec2<double> pixel(NAN, NAN);
         if (!model.lens.ProjectToPixel(mirror_point, &pixel)) pixel.setConstant(NAN);  // fails InImage below
         u[i] = pixel.x(), v[i] = pixel.y();
+        mirror_x[i] = mirror_point.x(), mirror_y[i] = mirror_point.y(), mirror_z[i] = mirror_point.z();
         distance[i] = std::sqrt((rho[i] - x) * (rho[i] - x) + (pz[i] - mirror_point.z() + translation.z()) *
                                                                   (pz[i] - mirror_point.z() + translation.z()));
       }
@@ -98,6 +100,7 @@ void ProjectPointsBatch(const Model& model, const ProjectionCache& cache, const 
         Vec2<double> pixel(NAN, NAN);
         if (!model.lens.ProjectToPixel(mirror_point, &pixel)) pixel.setConstant(NAN);  // fails InImage below
         u[i] = pixel.x(), v[i] = pixel.y();
+        mirror_x[i] = mirror_point.x(), mirror_y[i] = mirror_point.y(), mirror_z[i] = mirror_point.z();
         const Eigen::Vector3d point(block[3 * i], block[3 * i + 1], block[3 * i + 2]);
         distance[i] = (point - mirror_point).norm();
       }
@@ -111,10 +114,11 @@ void ProjectPointsBatch(const Model& model, const ProjectionCache& cache, const 
                 std::abs(point.z()) <= detail::kMaxCoordinateMm &&
                 last_step[i] < detail::AcceptStep(rim, distance[i]) && radius >= 0.0 && radius <= rim * detail::kRimSlack &&
                 rho[i] > 1e-12 * rim && ahead[i] > 0.0 && model.InImage(u[i], v[i]);
-      if (ok && model.camera_body_radius_mm > 0.0) {
-        Eigen::Vector3d mirror_point;
-        ok = model.ReflectionPoint(point, &mirror_point, &cache) == ProjectionStatus::kOk;
-      }
+      // The camera body, tested on the segment from the mirror point already found (a second
+      // solve here would double the cost of every point).
+      if (ok && detail::HitsCameraBody(Eigen::Vector3d(mirror_x[i], mirror_y[i], mirror_z[i]), point,
+                                       model.camera_body_radius_mm))
+        ok = false;  // the scalar path below reports kOccludedByCamera
       double* out = pixels_uv + 2 * (start + i);
       if (ok) {
         out[0] = u[i];
