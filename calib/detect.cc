@@ -1,5 +1,7 @@
 #include "calib/detect.h"
 
+#include "calib/virtual_view.h"
+
 #include <Eigen/Geometry>
 #include <apriltag/apriltag.h>
 #include <apriltag/tag36h11.h>
@@ -146,49 +148,15 @@ ImageDetections DetectThroughVirtualViews(const CalibrationTarget& target, const
       // towards the mirror's -z (a proper rotation: no mirror reversal).
       const Eigen::Vector3d forward_m(std::sin(omega_rad) * std::cos(azimuth), std::sin(omega_rad) * std::sin(azimuth),
                                       -std::cos(omega_rad));
-      Eigen::Vector3d right_m = forward_m.cross(Eigen::Vector3d::UnitZ());
-      if (right_m.norm() < 1e-9) right_m = Eigen::Vector3d::UnitX();
-      right_m.normalize();
-      const Eigen::Vector3d down_m = forward_m.cross(right_m);
-      Eigen::Matrix3d view_to_mirror;
-      view_to_mirror << right_m, down_m, forward_m;
-      const Eigen::Matrix3d view_to_camera = cache.camera_from_mirror_rotation * view_to_mirror;
-      Eigen::Matrix3Xd far(3, kSize * kSize);
-      for (int j = 0; j < kSize; ++j)
-        for (int i = 0; i < kSize; ++i)
-          far.col(j * kSize + i) =
-              centre + 1e7 * (view_to_camera * Eigen::Vector3d((i - 0.5 * (kSize - 1)) / focal, (j - 0.5 * (kSize - 1)) / focal, 1.0)).normalized();
-      Eigen::Matrix2Xd pixels;
-      std::vector<ProjectionStatus> statuses;
-      guess.ProjectBatch(far, &pixels, &statuses);
-      cv::Mat map_x(kSize, kSize, CV_32F), map_y(kSize, kSize, CV_32F);
-      for (int k = 0; k < kSize * kSize; ++k) {
-        const bool ok = statuses[k] == ProjectionStatus::kOk;
-        map_x.at<float>(k / kSize, k % kSize) = ok ? static_cast<float>(pixels(0, k)) : -1.0f;
-        map_y.at<float>(k / kSize, k % kSize) = ok ? static_cast<float>(pixels(1, k)) : -1.0f;
-      }
-      cv::Mat view;
-      cv::remap(grey, view, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+      const VirtualView virtual_view(guess, cache.camera_from_mirror_rotation * ViewFrame(forward_m, -Eigen::Vector3d::UnitZ()),
+                                     centre, focal, kSize, kSize);
+      const cv::Mat view = virtual_view.Resample(grey, cv::INTER_LINEAR);
       for (const auto& [id, corners] : DetectTags(target, view)) {
         std::array<Eigen::Vector2d, 4> omni;
         bool inside = true;
         Eigen::Vector2d mean = Eigen::Vector2d::Zero();
         for (int k = 0; k < 4; ++k) {
-          const double x = corners[k].x(), y = corners[k].y();
-          const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-          if (x0 < 0 || y0 < 0 || x0 + 1 >= kSize || y0 + 1 >= kSize) {
-            inside = false;
-            break;
-          }
-          const double a = x - x0, b = y - y0;
-          auto interpolate = [&](const cv::Mat& map) {
-            return (1 - a) * (1 - b) * map.at<float>(y0, x0) + a * (1 - b) * map.at<float>(y0, x0 + 1) +
-                   (1 - a) * b * map.at<float>(y0 + 1, x0) + a * b * map.at<float>(y0 + 1, x0 + 1);
-          };
-          for (int dy = 0; dy < 2; ++dy)
-            for (int dx = 0; dx < 2; ++dx)
-              if (map_x.at<float>(y0 + dy, x0 + dx) < 0.0f) inside = false;
-          omni[k] = Eigen::Vector2d(interpolate(map_x), interpolate(map_y));
+          inside = inside && virtual_view.ToOmni(corners[k], &omni[k]);
           mean += corners[k] / 4.0;
         }
         if (!inside) continue;

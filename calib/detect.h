@@ -8,8 +8,7 @@
 // assignment a proper rotation of the board; a checkerboard's corner set maps onto itself
 // under the remaining 180 deg ambiguity, so a fit is unaffected by it.
 //
-// Not yet: re-detection in virtual perspective views through a sensor guess (for tags
-// near the rim), sub-pixel refinement beyond the detectors' own.
+// Sub-pixel refinement of what these find: calib/refine_corners.h.
 #pragma once
 
 #include <opencv2/core.hpp>

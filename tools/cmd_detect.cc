@@ -1,5 +1,6 @@
 // omnical detect: the target's corners in omni images (AprilTag 3 or OpenCV's
-// checkerboard detector on the mirrored image),
+// checkerboard detector on the mirrored image; with --sensor, tags re-detected in virtual
+// perspective views through the guess), refined to sub-pixel (calib/refine_corners.h),
 // parallel over images; unreadable images are reported and skipped.
 #include <glob.h>
 
@@ -14,6 +15,7 @@
 #include <thread>
 
 #include "calib/detect.h"
+#include "calib/refine_corners.h"
 #include "model/input_error.h"
 #include "tools/commands.h"
 #include "tools/progress.h"
@@ -55,11 +57,14 @@ Command DetectCommand() {
             auto sensor_path = std::make_shared<std::string>();
             sub.add_option("--target", *spec, "Target spec (YAML, Kalibr keys)")->required();
             sub.add_option("--sensor", *sensor_path,
-                           "Sensor guess (YAML): re-detect aprilgrid tags in virtual perspective views through it");
+                           "Sensor guess (YAML): re-detect aprilgrid tags in virtual perspective views through it, refine corners in patches through it");
             sub.add_option("--images", *images, "Directory of images, or a glob pattern (quote it)")->required();
             sub.add_option("--out", *out, "Detections file (JSON)")->required();
+            auto no_refine = std::make_shared<bool>(false);
+            sub.add_flag("--no-refine", *no_refine, "Keep the detectors' corners (no sub-pixel refinement)");
             sub.add_option("--threads", *threads, "Worker threads")->check(CLI::Range(1, 256))->capture_default_str();
             return [=, &context]() {
+              const bool refine = !*no_refine;
               const CalibrationTarget target = CalibrationTarget::FromYaml(*spec);
               std::optional<Sensor> guess;
               if (!sensor_path->empty()) guess = LoadSensorYaml(*sensor_path);
@@ -78,9 +83,11 @@ Command DetectCommand() {
                     } else {
                       sizes[i] = grey.size();
                       found[i] = DetectTarget(target, grey);
-                      if (guess && target.type() == CalibrationTarget::Type::kAprilGrid && grey.cols == guess->image_width_px() &&
-                          grey.rows == guess->image_height_px())
+                      const bool through_guess =
+                          guess && grey.cols == guess->image_width_px() && grey.rows == guess->image_height_px();
+                      if (through_guess && target.type() == CalibrationTarget::Type::kAprilGrid)
                         found[i] = DetectThroughVirtualViews(target, grey, *guess, found[i]);
+                      if (refine) found[i] = RefineCorners(target, grey, through_guess ? &*guess : nullptr, found[i]);
                       found[i].image = paths[i];
                     }
                     progress.Advance();

@@ -1,0 +1,241 @@
+#include "calib/refine_corners.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "calib/virtual_view.h"
+
+namespace omnical {
+
+namespace {
+
+constexpr double kMagnification = 2.0;     // patch px per omni px (at least, along both axes)
+constexpr double kMinNeighbourPx = 64.0;  // aprilgrid: 8 px border cells
+
+// The corner ids next to `id` along the target's edges (aprilgrid: the two other corners
+// of its tag's black square; checkerboard: up to four grid neighbours).
+std::vector<int> NeighboursOf(const CalibrationTarget& target, int id) {
+  if (target.type() == CalibrationTarget::Type::kAprilGrid) {
+    const int tag = id / 4, k = id % 4;
+    return {4 * tag + (k + 1) % 4, 4 * tag + (k + 3) % 4};
+  }
+  const int cols = target.cols(), rows = target.rows(), row = id / cols, col = id % cols;
+  std::vector<int> neighbours;
+  if (col > 0) neighbours.push_back(id - 1);
+  if (col + 1 < cols) neighbours.push_back(id + 1);
+  if (row > 0) neighbours.push_back(id - cols);
+  if (row + 1 < rows) neighbours.push_back(id + cols);
+  return neighbours;
+}
+
+// cornerSubPix from `start` with half window `window_px`; false if it wandered off (more
+// than half the window: it found another edge, not this corner).
+bool SubPixel(const cv::Mat& image, const Eigen::Vector2d& start, double window_px, Eigen::Vector2d* refined) {
+  const int half = static_cast<int>(std::floor(window_px));
+  if (half < 2) return false;
+  std::vector<cv::Point2f> point{cv::Point2f(static_cast<float>(start.x()), static_cast<float>(start.y()))};
+  if (start.x() < half + 2 || start.y() < half + 2 || start.x() > image.cols - half - 3 || start.y() > image.rows - half - 3)
+    return false;
+  cv::cornerSubPix(image, point, cv::Size(half, half), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
+  *refined = Eigen::Vector2d(point[0].x, point[0].y);
+  return std::isfinite(refined->x()) && std::isfinite(refined->y()) && (*refined - start).norm() <= 0.5 * half;
+}
+
+// Bilinear sample of an 8-bit image; NaN outside.
+double Sample(const cv::Mat& image, const Eigen::Vector2d& at) {
+  const int x0 = static_cast<int>(std::floor(at.x())), y0 = static_cast<int>(std::floor(at.y()));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= image.cols || y0 + 1 >= image.rows) return NAN;
+  const double a = at.x() - x0, b = at.y() - y0;
+  return (1 - a) * (1 - b) * image.at<uint8_t>(y0, x0) + a * (1 - b) * image.at<uint8_t>(y0, x0 + 1) +
+         (1 - a) * b * image.at<uint8_t>(y0 + 1, x0) + a * b * image.at<uint8_t>(y0 + 1, x0 + 1);
+}
+
+// Where an edge crosses the profile base + s * normal, s from -inside_px (ink) to
+// +outside_px (paper): the crossing of the level halfway between the ink level and the
+// paper plateau (unbiased for any symmetric blur), nearest to s = 0. The ink level comes
+// from the caller: inside a small tag the border cell is too thin to show a plateau of its
+// own. False on a weak or missing edge.
+bool EdgeCrossing(const cv::Mat& image, const Eigen::Vector2d& base, const Eigen::Vector2d& normal, double inside_px,
+                  double outside_px, double ink, double* crossing) {
+  constexpr int kSamples = 41;
+  double values[kSamples], paper = 0.0;
+  int plateau = 0;
+  const double step = (inside_px + outside_px) / (kSamples - 1);
+  for (int k = 0; k < kSamples; ++k) {
+    const double s = -inside_px + step * k;
+    values[k] = Sample(image, base + s * normal);
+    if (!std::isfinite(values[k])) return false;
+    if (s >= 0.6 * outside_px) paper += values[k], ++plateau;
+  }
+  paper /= std::max(1, plateau);
+  if (paper - ink < 20.0) return false;
+  const double level = 0.5 * (ink + paper);
+  double best = HUGE_VAL;
+  for (int k = 0; k + 1 < kSamples; ++k) {
+    const double a = values[k] - level, b = values[k + 1] - level;
+    if (a * b > 0.0 || a == b) continue;
+    const double s = -inside_px + step * (k + a / (a - b));
+    if (std::abs(s) < std::abs(best)) best = s;
+  }
+  *crossing = best;
+  return std::isfinite(best);
+}
+
+// An aprilgrid corner is the convex corner of a black square on the white gap, where a
+// gradient-orthogonality window is biased (the blurred tip's gradients point along the
+// bisector). Instead each of the two edges is located along profiles across it, from 0.5
+// to 7 border cells from the corner (0.8 cell inside, 1.6 cells into the 2.4-cell gap),
+// fitted by a line, and the lines intersected; twice, the second time along the fitted
+// edges. Nearly the whole side averages the noise; its curvature in a magnified patch
+// through the guess is negligible.
+bool RefineSquareCorner(const cv::Mat& image, const Eigen::Vector2d& start, const Eigen::Vector2d (&towards)[2],
+                        double cell_px, Eigen::Vector2d* refined) {
+  if (cell_px < 1.5) return false;
+  Eigen::Vector2d corner = start, edge[2] = {towards[0].normalized(), towards[1].normalized()};
+  // Ink level: the darker decile of the square's interior near the corner (its border
+  // cells and black data cells).
+  std::vector<double> interior;
+  for (double a = 0.3; a <= 3.0; a += 0.25)
+    for (double b = 0.3; b <= 3.0; b += 0.25)
+      if (const double v = Sample(image, start + cell_px * (a * edge[0] + b * edge[1])); std::isfinite(v)) interior.push_back(v);
+  if (interior.size() < 20) return false;
+  std::nth_element(interior.begin(), interior.begin() + interior.size() / 10, interior.end());
+  const double ink = interior[interior.size() / 10];
+  for (int pass = 0; pass < 2; ++pass) {
+    Eigen::Vector2d point[2], direction[2];
+    for (int e = 0; e < 2; ++e) {
+      // Normal pointing out of the square: away from the other edge.
+      Eigen::Vector2d normal(-edge[e].y(), edge[e].x());
+      if (normal.dot(edge[1 - e]) > 0.0) normal = -normal;
+      std::vector<double> ts, ss;
+      for (double t = 0.5 * cell_px; t <= 7.0 * cell_px; t += 0.5)
+        if (double s; EdgeCrossing(image, corner + t * edge[e], normal, 0.8 * cell_px, 1.6 * cell_px, ink, &s))
+          ts.push_back(t), ss.push_back(s);
+      if (ts.size() < 4) return false;
+      // s = a + b t by least squares.
+      double mt = 0, ms = 0, stt = 0, sts = 0;
+      for (size_t i = 0; i < ts.size(); ++i) mt += ts[i], ms += ss[i];
+      mt /= ts.size();
+      ms /= ts.size();
+      for (size_t i = 0; i < ts.size(); ++i) stt += (ts[i] - mt) * (ts[i] - mt), sts += (ts[i] - mt) * (ss[i] - ms);
+      const double b = sts / stt, a = ms - b * mt;
+      // A straight edge fits its crossings to a small fraction of a cell; crossings
+      // scattered over the profile mean the start was off the corner (another edge, the
+      // data bits): keep the detector's point.
+      double scatter = 0.0;
+      for (size_t i = 0; i < ts.size(); ++i) scatter += std::pow(ss[i] - a - b * ts[i], 2);
+      const double profiles = (7.0 - 0.5) * cell_px / 0.5;
+      if (std::sqrt(scatter / ts.size()) > 0.1 * cell_px || ts.size() < 0.6 * profiles) return false;
+      point[e] = corner + a * normal;
+      direction[e] = (edge[e] + b * normal).normalized();
+    }
+    // point[0] + u direction[0] = point[1] + v direction[1]
+    Eigen::Matrix2d m;
+    m << direction[0], -direction[1];
+    if (std::abs(m.determinant()) < 0.2) return false;  // edges nearly parallel: not a corner
+    const Eigen::Vector2d uv = m.inverse() * (point[1] - point[0]);
+    corner = point[0] + uv.x() * direction[0];
+    edge[0] = direction[0];
+    edge[1] = direction[1];
+  }
+  if ((corner - start).norm() > 0.5 * cell_px) return false;
+  *refined = corner;
+  return true;
+}
+
+// Refines one corner in `image` given its neighbours' positions there. Returns false
+// where the detector's position is kept.
+bool RefineInImage(const CalibrationTarget& target, const cv::Mat& image, const Eigen::Vector2d& start,
+                   const std::vector<Eigen::Vector2d>& neighbours, Eigen::Vector2d* refined) {
+  double distance = HUGE_VAL;
+  for (const Eigen::Vector2d& n : neighbours) distance = std::min(distance, (n - start).norm());
+  if (!std::isfinite(distance)) return false;
+  if (target.type() == CalibrationTarget::Type::kCheckerboard)
+    return SubPixel(image, start, 0.4 * distance, refined);  // 0.4 square keeps off the next corners' edges
+  // tagStandard41h12 has data bits outside its black square: no clean edge profile there.
+  if (target.family() != "tag36h11" || neighbours.size() != 2) return false;
+  const Eigen::Vector2d towards[2] = {neighbours[0] - start, neighbours[1] - start};
+  return RefineSquareCorner(image, start, towards, distance / 8.0, refined);  // 8 cells across the black square
+}
+
+// The margin a refinement needs around the corner, in neighbour distances.
+double ReachOf(const CalibrationTarget& target) {
+  return target.type() == CalibrationTarget::Type::kCheckerboard ? 0.5 : (7.0 + 0.8) / 8.0;
+}
+
+}  // namespace
+
+ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& grey, const Sensor* guess,
+                              const ImageDetections& detections, CornerRefinementStats* stats) {
+  CornerRefinementStats local;
+  std::map<int, Eigen::Vector2d> by_id;
+  for (const CornerObservation& c : detections.corners) by_id[c.id] = c.pixel;
+  // Rays of every corner (with a guess): the patch of a corner looks along its own ray,
+  // and its neighbours' rays place them in the patch.
+  std::map<int, std::pair<Eigen::Vector3d, Eigen::Vector3d>> rays;
+  if (guess)
+    for (const auto& [id, pixel] : by_id) {
+      Eigen::Vector3d origin, direction;
+      if (guess->Unproject(pixel, &origin, &direction) == ProjectionStatus::kOk) rays[id] = {origin, direction};
+    }
+
+  ImageDetections out = detections;
+  for (CornerObservation& corner : out.corners) {
+    const std::vector<int> neighbour_ids = NeighboursOf(target, corner.id);
+    bool moved = false;
+    Eigen::Vector2d refined;
+    if (!guess) {
+      std::vector<Eigen::Vector2d> neighbours;
+      for (int n : neighbour_ids)
+        if (by_id.count(n)) neighbours.push_back(by_id[n]);
+      moved = RefineInImage(target, grey, corner.pixel, neighbours, &refined);
+    } else if (rays.count(corner.id)) {
+      const auto& [origin, direction] = rays[corner.id];
+      // Patch focal length: kMagnification x the omni image's px per rad around this ray,
+      // the larger of the two directions so neither is undersampled.
+      const Eigen::Matrix3d frame = ViewFrame(direction, -guess->cache().camera_from_mirror_rotation.col(2));
+      double omni_px_per_rad = 0.0;
+      for (int axis = 0; axis < 2; ++axis) {
+        Eigen::Vector2d offset_pixel;
+        const double step_rad = 1e-3;
+        if (guess->Project(origin + 1e8 * (direction + step_rad * frame.col(axis)).normalized(), &offset_pixel) ==
+            ProjectionStatus::kOk)
+          omni_px_per_rad = std::max(omni_px_per_rad, (offset_pixel - corner.pixel).norm() / step_rad);
+      }
+      std::vector<Eigen::Vector2d> neighbours;  // in patch px from the patch centre, per unit focal length
+      double distance = HUGE_VAL;
+      for (int n : neighbour_ids)
+        if (rays.count(n)) {
+          const Eigen::Vector3d v = frame.transpose() * rays[n].second;
+          if (v.z() <= 0.0) continue;
+          neighbours.emplace_back(v.x() / v.z(), v.y() / v.z());
+          distance = std::min(distance, neighbours.back().norm());
+        }
+      // Small corners are magnified further, so that the neighbour sits kMinNeighbourPx
+      // away in the patch and the edge profiles get enough samples.
+      const double focal = std::max(kMagnification * omni_px_per_rad, kMinNeighbourPx / distance);
+      distance *= focal;
+      for (Eigen::Vector2d& n : neighbours) n *= focal;
+      // Bounded: a corner whose neighbours sit absurdly far is not refined.
+      if (omni_px_per_rad > 0.0 && std::isfinite(distance) && distance < 2000.0) {
+        const int half_size = static_cast<int>(std::ceil(ReachOf(target) * distance)) + 4;
+        const VirtualView patch(*guess, frame, origin, focal, 2 * half_size + 1, 2 * half_size + 1);
+        const cv::Mat image = patch.Resample(grey, cv::INTER_CUBIC);
+        const Eigen::Vector2d centre(half_size, half_size);
+        for (Eigen::Vector2d& n : neighbours) n += centre;
+        Eigen::Vector2d refined_patch;
+        moved = RefineInImage(target, image, centre, neighbours, &refined_patch) && patch.ToOmni(refined_patch, &refined);
+      }
+    }
+    if (moved) corner.pixel = refined;
+    ++(moved ? local.refined : local.kept);
+  }
+  if (stats) *stats = local;
+  return out;
+}
+
+}  // namespace omnical

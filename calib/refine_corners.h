@@ -1,0 +1,32 @@
+// Sub-pixel refinement of detected corners. Detectors place corners from fitted quad
+// edges (AprilTag) or a smoothed response (checkerboard); the gradient-orthogonality
+// criterion (OpenCV's cornerSubPix) is sharper when its window holds just the corner's two
+// edges. The window is sized per corner from the target itself: a fraction of the tag's
+// border cell (an aprilgrid corner is the corner of the tag's black square, so the window
+// must stay inside one cell) or of the checkerboard square.
+//
+// With a sensor guess, each corner is refined in a small perspective patch resampled from
+// the omni image (bicubic) around the corner's own ray, magnified ~2x: the mirror's
+// anisotropic compression near the rim is undone there, and the refined point is mapped
+// back through the patch's own table of exact projections, so the guess's error does not
+// move it. Without a guess the refinement runs on the omni image where the window is at
+// least 2 px; smaller corners keep the detector's position.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "calib/detections.h"
+#include "calib/target.h"
+#include "model/sensor.h"
+
+namespace omnical {
+
+struct CornerRefinementStats {
+  int refined = 0;  // moved by the refinement
+  int kept = 0;     // left where the detector put them (window too small, no neighbours, or diverged)
+};
+
+ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& grey, const Sensor* guess,
+                              const ImageDetections& detections, CornerRefinementStats* stats = nullptr);
+
+}  // namespace omnical

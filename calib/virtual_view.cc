@@ -1,0 +1,75 @@
+#include "calib/virtual_view.h"
+
+#include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+
+namespace omnical {
+
+namespace {
+// Far enough that the rays' origins on the mirror (mm apart) do not matter (1e-8 rad).
+constexpr double kFarMm = 1e8;
+}  // namespace
+
+VirtualView::VirtualView(const Sensor& sensor, const Eigen::Matrix3d& view_to_camera,
+                         const Eigen::Vector3d& centre_in_camera_mm, double focal_px, int width_px, int height_px)
+    : view_to_camera_(view_to_camera), focal_px_(focal_px) {
+  const double cx = 0.5 * (width_px - 1), cy = 0.5 * (height_px - 1);
+  Eigen::Matrix3Xd far(3, static_cast<Eigen::Index>(width_px) * height_px);
+  for (int j = 0; j < height_px; ++j)
+    for (int i = 0; i < width_px; ++i)
+      far.col(static_cast<Eigen::Index>(j) * width_px + i) =
+          centre_in_camera_mm + kFarMm * (view_to_camera * Eigen::Vector3d((i - cx) / focal_px, (j - cy) / focal_px, 1.0)).normalized();
+  Eigen::Matrix2Xd pixels;
+  std::vector<ProjectionStatus> statuses;
+  sensor.ProjectBatch(far, &pixels, &statuses);
+  map_x_.create(height_px, width_px, CV_32F);
+  map_y_.create(height_px, width_px, CV_32F);
+  for (Eigen::Index k = 0; k < far.cols(); ++k) {
+    const bool ok = statuses[k] == ProjectionStatus::kOk;
+    map_x_.at<float>(static_cast<int>(k / width_px), static_cast<int>(k % width_px)) = ok ? static_cast<float>(pixels(0, k)) : -1.0f;
+    map_y_.at<float>(static_cast<int>(k / width_px), static_cast<int>(k % width_px)) = ok ? static_cast<float>(pixels(1, k)) : -1.0f;
+  }
+}
+
+cv::Mat VirtualView::Resample(const cv::Mat& omni_grey, int interpolation) const {
+  cv::Mat view;
+  cv::remap(omni_grey, view, map_x_, map_y_, interpolation, cv::BORDER_CONSTANT, cv::Scalar(0));
+  return view;
+}
+
+Eigen::Vector2d VirtualView::ToView(const Eigen::Vector3d& direction_in_camera) const {
+  const Eigen::Vector3d in_view = view_to_camera_.transpose() * direction_in_camera;
+  return Eigen::Vector2d(focal_px_ * in_view.x() / in_view.z() + 0.5 * (width_px() - 1),
+                         focal_px_ * in_view.y() / in_view.z() + 0.5 * (height_px() - 1));
+}
+
+bool VirtualView::ToOmni(const Eigen::Vector2d& view_px, Eigen::Vector2d* omni_px) const {
+  const double x = view_px.x(), y = view_px.y();
+  if (!std::isfinite(x) || !std::isfinite(y)) return false;
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= width_px() || y0 + 1 >= height_px()) return false;
+  for (int dy = 0; dy < 2; ++dy)
+    for (int dx = 0; dx < 2; ++dx)
+      if (map_x_.at<float>(y0 + dy, x0 + dx) < 0.0f) return false;
+  const double a = x - x0, b = y - y0;
+  auto interpolate = [&](const cv::Mat& map) {
+    return (1 - a) * (1 - b) * map.at<float>(y0, x0) + a * (1 - b) * map.at<float>(y0, x0 + 1) +
+           (1 - a) * b * map.at<float>(y0 + 1, x0) + a * b * map.at<float>(y0 + 1, x0 + 1);
+  };
+  *omni_px = Eigen::Vector2d(interpolate(map_x_), interpolate(map_y_));
+  return true;
+}
+
+Eigen::Matrix3d ViewFrame(const Eigen::Vector3d& forward, const Eigen::Vector3d& down_hint) {
+  const Eigen::Vector3d f = forward.normalized();
+  Eigen::Vector3d right = down_hint.cross(f);  // then f x right is down_hint's part across f
+  if (right.norm() < 1e-9) right = f.unitOrthogonal();
+  right.normalize();
+  Eigen::Matrix3d frame;
+  frame << right, f.cross(right), f;
+  return frame;
+}
+
+}  // namespace omnical
