@@ -80,7 +80,9 @@ DetectionSet DetectionsFromGroundTruth(const std::vector<std::string>& truth_pat
       set.image_width_px = json.at("image_size").at(0).get<int>();
       set.image_height_px = json.at("image_size").at(1).get<int>();
       for (const nlohmann::json& target : json.at("targets")) {
-        set.target_spec = target.at("spec").get<std::string>();
+        // A relative spec is relative to the ground-truth file (omnical render writes it so).
+        const std::filesystem::path spec = target.at("spec").get<std::string>();
+        set.target_spec = (spec.is_absolute() ? spec : std::filesystem::path(path).parent_path() / spec).lexically_normal().string();
         ImageDetections image;
         image.image = (std::filesystem::path(path).parent_path() / json.at("image").get<std::string>()).string();
         for (const nlohmann::json& corner : target.at("corners"))

@@ -1,5 +1,6 @@
-// omnical calibrate: the bundle fit of the non-central model from detections and a
-// sensor guess -> sensor.yaml, calibration.json and a report of PNG figures. Everything is
+// omnical calibrate: the bundle fit of the non-central model from images (detected here)
+// or detections, starting from a sensor guess or, without one, from the mirror's rim
+// circle -> sensor.yaml, calibration.json and a report of PNG figures. Everything is
 // checked and computed before anything is written.
 #include <nlohmann/json.hpp>
 
@@ -11,19 +12,26 @@
 #include <filesystem>
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <sstream>
+#include <thread>
 
 #include "calib/bundle_fit.h"
+#include "calib/initial_sensor.h"
+#include "calib/rim_circle.h"
 #include "model/atomic_write.h"
 #include "model/input_error.h"
 #include "tools/commands.h"
+#include "tools/detect_images.h"
 #include "tools/plot.h"
 
 namespace omnical::cli {
 namespace {
 
 struct Options {
-  std::string target_path, detections_path, sensor_path, out_dir, fix;
+  std::string target_path, detections_path, images, sensor_path, profile, out_dir, fix;
+  double rim_field_deg = kDefaultRimFieldDeg;
+  int threads = 1;
   double loss_px = 1.0;
   int max_iterations = 200;
   bool leave_one_out = false;
@@ -96,12 +104,61 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
   WritePng((dir / "per_view_rms.png").string(), RenderPanel(per_view, 800, 500));
 }
 
+// The rim circle of the images a detections file names (the median over those that read).
+std::optional<RimCircle> RimOfImages(const DetectionSet& detections) {
+  std::vector<RimCircle> circles;
+  for (const ImageDetections& image : detections.images) {
+    const cv::Mat grey = cv::imread(image.image, cv::IMREAD_GRAYSCALE);
+    if (grey.empty()) continue;
+    if (auto circle = DetectRimCircle(grey)) circles.push_back(*circle);
+  }
+  return MedianRimCircle(circles);
+}
+
 void Run(const Options& options, const Context& context) {
   const CalibrationTarget target = CalibrationTarget::FromYaml(options.target_path);
-  DetectionSet detections = ReadDetections(options.detections_path);
-  const Sensor guess = LoadSensorYaml(options.sensor_path);
+  if (options.images.empty() == options.detections_path.empty())
+    throw InputError("calibrate: give either --images (detect here) or --detections (from omnical detect)");
+  std::optional<Sensor> given;
+  if (!options.sensor_path.empty()) given = LoadSensorYaml(options.sensor_path);
+  // Where the corners come from, named in messages.
+  const std::string source = options.images.empty() ? options.detections_path : options.images;
+  DetectionSet detections;
+  std::optional<RimCircle> rim;
+  if (!options.images.empty()) {
+    ImageDetectionOptions detection;
+    detection.guess = given ? &*given : nullptr;
+    detection.rim_circles = !given;
+    detection.threads = options.threads;
+    detection.quiet = context.quiet;
+    DetectedImages found = DetectImages(target, options.target_path, options.images, detection);
+    detections = std::move(found.detections);
+    if (!given) rim = MedianRimCircle(found.rim_circles);
+  } else {
+    detections = ReadDetections(options.detections_path);
+    if (!given) rim = RimOfImages(detections);
+  }
+  // The starting sensor: the guess (in another profile family if asked), or, with no
+  // guess, the rim circle of the images.
+  std::string start;
+  std::optional<Sensor> start_sensor;
+  if (given) {
+    start_sensor = options.profile.empty() ? *given : ConvertProfile(*given, options.profile);
+    start = options.sensor_path + (options.profile.empty() ? "" : " as a " + options.profile + " mirror");
+  } else {
+    if (!rim)
+      throw InputError(InputMessage(source, "images",
+                                    "no mirror rim circle found to start from; give a sensor guess with --sensor"));
+    const std::string profile = options.profile.empty() ? "polynomial" : options.profile;
+    start_sensor = SensorFromRimCircle(*rim, detections.image_width_px, detections.image_height_px, profile, options.rim_field_deg);
+    start = "rim circle, " + profile + " mirror, orthographic lens";
+    if (!context.quiet)
+      std::printf("rim circle: centre (%.2f, %.2f) px, radius %.2f px (%.0f%% of rays, %.2f px RMS)\n", rim->centre_px.x(),
+                  rim->centre_px.y(), rim->radius_px, 100.0 * rim->inlier_fraction, rim->rms_px);
+  }
+  const Sensor& guess = *start_sensor;
   if (detections.image_width_px != guess.image_width_px() || detections.image_height_px != guess.image_height_px())
-    throw InputError(InputMessage(options.detections_path, "image_size",
+    throw InputError(InputMessage(source, "image_size",
                                   std::to_string(detections.image_width_px) + " x " + std::to_string(detections.image_height_px) +
                                       " differs from the sensor's " + std::to_string(guess.image_width_px()) + " x " +
                                       std::to_string(guess.image_height_px())));
@@ -122,7 +179,7 @@ void Run(const Options& options, const Context& context) {
     matched += static_cast<int>(image.corners.size());
   }
   if (matched == 0)
-    throw InputError(InputMessage(options.target_path, "", "the target spec matches no corner id in " + options.detections_path));
+    throw InputError(InputMessage(options.target_path, "", "the target spec matches no corner id in " + source));
   DetectionSet usable = detections;
   usable.images.clear();
   std::vector<TargetPose> poses;
@@ -142,7 +199,7 @@ void Run(const Options& options, const Context& context) {
   for (const ImageDetections& image : usable.images) observations += static_cast<int>(image.corners.size());
   const int sensor_parameters = static_cast<int>(SensorParameters(guess).size());
   if (usable.images.size() < 3 || 2 * observations < 2 * (6 * static_cast<int>(usable.images.size()) + sensor_parameters))
-    throw InputError(InputMessage(options.detections_path, "images",
+    throw InputError(InputMessage(source, "images",
                                   std::to_string(usable.images.size()) + " usable views with " + std::to_string(observations) +
                                       " corners are too few for the " + std::to_string(sensor_parameters) +
                                       " sensor parameters (need >= 3 views)"));
@@ -152,10 +209,10 @@ void Run(const Options& options, const Context& context) {
     spread_mm = std::max(spread_mm, (pose.camera_from_target_translation_mm - poses[0].camera_from_target_translation_mm).norm());
   }
   if (spread_deg < 1.0 && spread_mm < 5.0)
-    throw InputError(InputMessage(options.detections_path, "images", "all views show the target at one pose: move it between images"));
+    throw InputError(InputMessage(source, "images", "all views show the target at one pose: move it between images"));
 
   const FitResult fit = FitSensor(guess, target, usable, poses, fit_options);
-  if (!fit.sensor) throw InputError(InputMessage(options.detections_path, "", "the fit failed: " + fit.solver_report));
+  if (!fit.sensor) throw InputError(InputMessage(source, "", "the fit failed: " + fit.solver_report));
   const std::string why_invalid = ValidateSensorModel(fit.sensor->model());
 
   nlohmann::json result;
@@ -168,6 +225,12 @@ void Run(const Options& options, const Context& context) {
   result["fixed_blocks"] = fit_options.fixed;
   result["robust_loss_px"] = fit_options.robust_loss_px;
   result["covariance_ok"] = fit.covariance_ok;
+  result["start"] = start;
+  if (rim)
+    result["rim_circle"] = {{"centre_px", {rim->centre_px.x(), rim->centre_px.y()}},
+                            {"radius_px", rim->radius_px},
+                            {"inlier_fraction", rim->inlier_fraction},
+                            {"rms_px", rim->rms_px}};
   // Stability: the fit repeated without each image in turn; the spread of each parameter.
   if (options.leave_one_out) {
     std::map<std::string, std::vector<double>> folds;
@@ -230,6 +293,7 @@ void Run(const Options& options, const Context& context) {
   const std::filesystem::path dir(options.out_dir);
   std::filesystem::create_directories(dir);
   SaveSensorYaml(*fit.sensor, (dir / "sensor.yaml").string());
+  if (!options.images.empty()) WriteDetections(detections, (dir / "detections.json").string());
   WriteFileAtomically((dir / "calibration.json").string(), [&](std::ostream& out) { out << result.dump(2) << '\n'; });
   WriteReport(dir / "report", usable, fit);
   for (const std::string& w : warnings) std::fprintf(stderr, "omnical: warning: %s\n", w.c_str());
@@ -249,12 +313,25 @@ void Run(const Options& options, const Context& context) {
 }  // namespace
 
 Command CalibrateCommand() {
-  return {"calibrate", "Bundle fit of the non-central model from detections and a sensor guess",
+  return {"calibrate", "Bundle fit of the non-central model from images or detections (and a guess, or the rim circle)",
           [](CLI::App& sub, const Context& context) -> CommandAction {
             auto options = std::make_shared<Options>();
             sub.add_option("--target", options->target_path, "Target spec (YAML, Kalibr keys)")->required();
-            sub.add_option("--detections", options->detections_path, "Detections (JSON, from omnical detect)")->required();
-            sub.add_option("--sensor", options->sensor_path, "Sensor guess (YAML): nominal design values")->required();
+            sub.add_option("--images", options->images,
+                           "Directory of images or a glob pattern: detect here (detections.json is written to --out)");
+            sub.add_option("--detections", options->detections_path, "Detections (JSON, from omnical detect)");
+            sub.add_option("--sensor", options->sensor_path,
+                           "Sensor guess (YAML): nominal design values. Without it the fit starts from the mirror's "
+                           "rim circle in the images (orthographic lens, scale held)");
+            sub.add_option("--profile", options->profile,
+                           "Mirror family to fit: sphere, paraboloid, polynomial (default without a guess), hyperboloid "
+                           "(needs --sensor); a guess of another family is converted")
+                ->check(CLI::IsMember({"sphere", "paraboloid", "polynomial", "hyperboloid"}));
+            sub.add_option("--rim-field-deg", options->rim_field_deg,
+                           "Without a guess: the rim ray's angle from the mirror axis (Omega, deg) to start from")
+                ->check(CLI::Range(10.0, 170.0))->capture_default_str();
+            options->threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+            sub.add_option("--threads", options->threads, "Detection threads")->check(CLI::Range(1, 256))->capture_default_str();
             sub.add_option("--out", options->out_dir, "Output directory")->required();
             sub.add_option("--fix", options->fix, "Blocks held constant: lens, lens_scale, distortion, m, tilt, decenter, shape, poses");
             sub.add_option("--loss-px", options->loss_px, "Huber loss scale, px (0: least squares)")

@@ -20,7 +20,7 @@
 namespace omnical::cli {
 namespace {
 
-nlohmann::json TruthJson(const SceneView& view, const std::vector<TargetTruth>& truth, const std::string& sensor_yaml,
+nlohmann::json TruthJson(const SceneView& view, const std::vector<TargetTruth>& truth, const std::string& out_dir, const std::string& sensor_yaml,
                          const Sensor& sensor) {
   nlohmann::json out;
   out["view"] = view.name;
@@ -33,7 +33,8 @@ nlohmann::json TruthJson(const SceneView& view, const std::vector<TargetTruth>& 
     const PlacedTarget& placed = *target.placement;
     nlohmann::json t;
     t["name"] = placed.name;
-    t["spec"] = placed.spec_path;
+    // Relative to the output directory, so a rendered set moves with its repository.
+    t["spec"] = std::filesystem::proximate(std::filesystem::absolute(placed.spec_path), std::filesystem::absolute(out_dir)).string();
     t["type"] = placed.target->type() == CalibrationTarget::Type::kAprilGrid ? "aprilgrid" : "checkerboard";
     nlohmann::json rotation = nlohmann::json::array();
     for (int r = 0; r < 3; ++r)
@@ -84,7 +85,7 @@ Command RenderCommand() {
               const auto start = std::chrono::steady_clock::now();
               const PixelRayGrid rays(sensor, *threads);
               nlohmann::json index;
-              index["scene"] = *scene_path;
+              index["scene"] = std::filesystem::proximate(std::filesystem::absolute(*scene_path), std::filesystem::absolute(dir)).string();
               index["sensor_file"] = "sensor.yaml";
               for (size_t k = 0; k < scene.views.size(); ++k) {
                 const SceneView& view = scene.views[k];
@@ -101,7 +102,7 @@ Command RenderCommand() {
                 WriteFileAtomically((dir / (view.name + ".png")).string(), [&](std::ostream& out) {
                   out.write(reinterpret_cast<const char*>(png.data()), png.size());
                 });
-                const nlohmann::json truth = TruthJson(view, GroundTruth(sensor, view), sensor_yaml.str(), sensor);
+                const nlohmann::json truth = TruthJson(view, GroundTruth(sensor, view), *out_dir, sensor_yaml.str(), sensor);
                 WriteFileAtomically((dir / (view.name + ".json")).string(),
                                     [&](std::ostream& out) { out << truth.dump(1) << '\n'; });
                 index["views"].push_back({{"name", view.name}, {"image", view.name + ".png"}, {"truth", view.name + ".json"}});

@@ -1,0 +1,35 @@
+// The mirror's rim in an omni image: the circle where the bright mirror disc ends and the
+// dark housing (or the unlit sensor) begins. Without a datasheet or a guess it is all an
+// image tells about the sensor: its centre is the principal point (to the mirror's
+// decenter and tilt) and its radius the scale of the image mapping.
+//
+// Along 720 rays from a centre, the rim is the radius with the largest drop from the mean
+// intensity just inside to the mean over a long stretch outside (the outside of the rim
+// stays dark everywhere, the outside of an edge inside the mirror does not); a circle is
+// fitted to those points by RANSAC (1.5 px) and least squares, then the search repeats
+// around it. Rays that leave the image before the rim (a disc cut by the frame) drop out.
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include <optional>
+#include <vector>
+
+namespace omnical {
+
+struct RimCircle {
+  Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
+  double radius_px = 0.0;
+  double inlier_fraction = 0.0;  // of the 720 rays, how many agree with the circle (1.5 px)
+  double rms_px = 0.0;           // of the inliers about the fitted circle
+};
+
+// Nothing if no circle is supported by at least a third of the rays.
+std::optional<RimCircle> DetectRimCircle(const cv::Mat& grey);
+
+// The median centre and radius of several images' circles (the rim does not move on the
+// sensor); nothing if none was found.
+std::optional<RimCircle> MedianRimCircle(const std::vector<RimCircle>& circles);
+
+}  // namespace omnical

@@ -1,0 +1,81 @@
+// The mirror's rim circle found in images: against the rim's true projection on renders,
+// across the ten real images, and nothing on images with no mirror.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include "calib/rim_circle.h"
+#include "test_sensors.h"
+
+namespace omnical {
+namespace {
+
+// Radius (px) where pixels along the row through (cx, cy) stop seeing the mirror: bisection
+// on the unprojection status, to 1e-3 px.
+double TrueRimRadiusPx(const Sensor& sensor, const Eigen::Vector2d& centre) {
+  double inside = 1.0, outside = 0.5 * sensor.image_width_px() + 50.0;
+  Eigen::Vector3d origin, direction;
+  for (int i = 0; i < 40; ++i) {
+    const double mid = 0.5 * (inside + outside);
+    const bool sees = sensor.Unproject(centre + Eigen::Vector2d(mid, 0.0), &origin, &direction) == ProjectionStatus::kOk;
+    (sees ? inside : outside) = mid;
+  }
+  return inside;
+}
+
+// The aligned SPH sensor: the rim is a circle about the principal point. Tolerances: the
+// edge points scatter by ~1.3 px (blur, 1 px steps) over ~600 rays, so the fitted centre and
+// radius are good to a few tenths of a pixel; 0.5 px centre, 1 px radius (the rendered disc
+// ends in a partial pixel, antialiased).
+TEST(RimCircle, FindsTheRimOfARenderedMirror) {
+  for (const std::string view : {"ohte-sph-near/near000.png", "ohte-sph-far/far002.png", "ohte-edi-near/near001.png"}) {
+    const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/" + view.substr(0, view.find('/'));
+    const Sensor sensor = LoadSensorYaml(set + "/sensor.yaml");
+    const cv::Mat grey = cv::imread(testing::SourceDir() + "/datasets-synthetic/rendered/" + view, cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(grey.empty()) << view;
+    const auto circle = DetectRimCircle(grey);
+    ASSERT_TRUE(circle) << view;
+    const Eigen::Vector2d principal(0.5 * (sensor.image_width_px() - 1), 0.5 * (sensor.image_height_px() - 1));
+    EXPECT_LT((circle->centre_px - principal).norm(), 0.5) << view;
+    EXPECT_NEAR(circle->radius_px, TrueRimRadiusPx(sensor, principal), 1.0) << view;
+    EXPECT_GT(circle->inlier_fraction, 0.5) << view;
+  }
+}
+
+// No mirror: a uniform frame, and uniform noise, give nothing.
+TEST(RimCircle, FindsNothingWithoutAMirror) {
+  EXPECT_FALSE(DetectRimCircle(cv::Mat(480, 640, CV_8U, cv::Scalar(128))));
+  cv::Mat noise(480, 640, CV_8U);
+  cv::randu(noise, 0, 255);
+  EXPECT_FALSE(DetectRimCircle(noise));
+  EXPECT_FALSE(DetectRimCircle(cv::Mat()));
+}
+
+// The ten real images: the rim does not move on the sensor, so every image's circle must
+// agree with the median to the edge scatter (2 px).
+TEST(RimCircle, AgreesAcrossTheRealImages) {
+  const std::string data = testing::SourceDir() + "/../shared/real-data/mei-parabolic";
+  if (!std::filesystem::exists(data)) GTEST_SKIP() << data << " is absent";
+  std::vector<RimCircle> circles;
+  for (int k = 1; k <= 10; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/img_para_%03d.pgm", k);
+    const auto circle = DetectRimCircle(cv::imread(data + name, cv::IMREAD_GRAYSCALE));
+    ASSERT_TRUE(circle) << name;
+    circles.push_back(*circle);
+  }
+  const auto median = MedianRimCircle(circles);
+  ASSERT_TRUE(median);
+  for (const RimCircle& c : circles) {
+    EXPECT_LT((c.centre_px - median->centre_px).norm(), 2.0);
+    EXPECT_NEAR(c.radius_px, median->radius_px, 2.0);
+  }
+}
+
+}  // namespace
+}  // namespace omnical
