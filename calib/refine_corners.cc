@@ -13,7 +13,7 @@ namespace omnical {
 namespace {
 
 constexpr double kMagnification = 2.0;     // patch px per omni px (at least, along both axes)
-constexpr double kMinNeighbourPx = 64.0;  // aprilgrid: 8 px border cells
+constexpr double kMinNeighbourPx = 64.0;  // aprilgrid: 8 px border cells; checkerboard: a 25 px window
 
 // The corner ids next to `id` along the target's edges (aprilgrid: the two other corners
 // of its tag's black square; checkerboard: up to four grid neighbours).
