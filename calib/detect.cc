@@ -18,23 +18,24 @@
 
 namespace omnical {
 
-ImageDetections DetectAprilGrid(const CalibrationTarget& target, const cv::Mat& grey, DetectionStats* stats) {
-  if (target.type() != CalibrationTarget::Type::kAprilGrid)
-    throw std::invalid_argument("only aprilgrid targets can be detected so far");
-  DetectionStats local;
-  cv::Mat flipped;
-  cv::flip(grey, flipped, 1);  // undo the mirror's reversal of handedness
-  if (!flipped.isContinuous()) flipped = flipped.clone();
+namespace {
+
+// AprilTag 3 over an image (corners in its pixel-centre coordinates): the target's ids
+// only, and an id decoded twice dropped altogether (which copy is the tag is unknown).
+std::map<int, std::array<Eigen::Vector2d, 4>> DetectTags(const CalibrationTarget& target, const cv::Mat& image,
+                                                         DetectionStats* stats) {
   apriltag_family_t* family = target.family() == "tag36h11" ? tag36h11_create() : tagStandard41h12_create();
   apriltag_detector_t* detector = apriltag_detector_create();
   apriltag_detector_add_family(detector, family);
   detector->quad_decimate = 1.0f;  // full resolution: corners are what calibration needs
   detector->nthreads = 1;          // images are processed in parallel instead
   detector->refine_edges = true;
-  image_u8_t frame{flipped.cols, flipped.rows, static_cast<int32_t>(flipped.step), flipped.data};
+  cv::Mat continuous = image.isContinuous() ? image : image.clone();
+  image_u8_t frame{continuous.cols, continuous.rows, static_cast<int32_t>(continuous.step), continuous.data};
   zarray_t* detections = apriltag_detector_detect(detector, &frame);
   const int first = target.code_offset(), last = first + target.cols() * target.rows() - 1;
-  std::map<int, std::array<Eigen::Vector2d, 4>> by_id;
+  DetectionStats local;
+  std::map<int, std::array<Eigen::Vector2d, 4>> tags;
   std::map<int, int> seen;
   for (int i = 0; i < zarray_size(detections); ++i) {
     apriltag_detection_t* d;
@@ -45,27 +46,30 @@ ImageDetections DetectAprilGrid(const CalibrationTarget& target, const cv::Mat& 
     }
     if (++seen[d->id] > 1) continue;
     std::array<Eigen::Vector2d, 4> corners;
-    for (int k = 0; k < 4; ++k) {
-      // AprilTag puts pixel centres at +0.5; flip the column back.
-      const double u_flipped = d->p[k][0] - 0.5, v = d->p[k][1] - 0.5;
-      corners[k] = Eigen::Vector2d(grey.cols - 1 - u_flipped, v);
-    }
-    by_id[d->id] = corners;
+    for (int k = 0; k < 4; ++k) corners[k] = Eigen::Vector2d(d->p[k][0] - 0.5, d->p[k][1] - 0.5);  // AprilTag's centres: +0.5
+    tags[d->id] = corners;
   }
+  for (const auto& [id, count] : seen)
+    if (count > 1) tags.erase(id), ++local.duplicates;
+  local.tags = static_cast<int>(tags.size());
   apriltag_detections_destroy(detections);
   apriltag_detector_destroy(detector);
   if (target.family() == "tag36h11") tag36h11_destroy(family); else tagStandard41h12_destroy(family);
-
-  ImageDetections image;
-  for (const auto& [id, corners] : by_id) {
-    if (seen[id] > 1) {
-      ++local.duplicates;
-      continue;
-    }
-    ++local.tags;
-    for (int k = 0; k < 4; ++k) image.corners.push_back({4 * id + k, corners[k]});
-  }
   if (stats) *stats = local;
+  return tags;
+}
+
+}  // namespace
+
+ImageDetections DetectAprilGrid(const CalibrationTarget& target, const cv::Mat& grey, DetectionStats* stats) {
+  if (target.type() != CalibrationTarget::Type::kAprilGrid)
+    throw std::invalid_argument("only aprilgrid targets can be detected so far");
+  cv::Mat flipped;
+  cv::flip(grey, flipped, 1);  // undo the mirror's reversal of handedness
+  ImageDetections image;
+  for (const auto& [id, corners] : DetectTags(target, flipped, stats))
+    for (int k = 0; k < 4; ++k)  // flip the column back
+      image.corners.push_back({4 * id + k, Eigen::Vector2d(grey.cols - 1 - corners[k].x(), corners[k].y())});
   return image;
 }
 
@@ -89,39 +93,6 @@ ImageDetections DetectCheckerboard(const CalibrationTarget& target, const cv::Ma
   return image;
 }
 
-namespace {
-
-// AprilTag detections (corners in the given image's pixel-centre coordinates, no flip).
-std::map<int, std::array<Eigen::Vector2d, 4>> DetectTags(const CalibrationTarget& target, const cv::Mat& image) {
-  apriltag_family_t* family = target.family() == "tag36h11" ? tag36h11_create() : tagStandard41h12_create();
-  apriltag_detector_t* detector = apriltag_detector_create();
-  apriltag_detector_add_family(detector, family);
-  detector->quad_decimate = 1.0f;
-  detector->nthreads = 1;
-  detector->refine_edges = true;
-  cv::Mat continuous = image.isContinuous() ? image : image.clone();
-  image_u8_t frame{continuous.cols, continuous.rows, static_cast<int32_t>(continuous.step), continuous.data};
-  zarray_t* detections = apriltag_detector_detect(detector, &frame);
-  const int first = target.code_offset(), last = first + target.cols() * target.rows() - 1;
-  std::map<int, std::array<Eigen::Vector2d, 4>> tags;
-  std::map<int, int> seen;
-  for (int i = 0; i < zarray_size(detections); ++i) {
-    apriltag_detection_t* d;
-    zarray_get(detections, i, &d);
-    if (d->id < first || d->id > last || ++seen[d->id] > 1) continue;
-    std::array<Eigen::Vector2d, 4> corners;
-    for (int k = 0; k < 4; ++k) corners[k] = Eigen::Vector2d(d->p[k][0] - 0.5, d->p[k][1] - 0.5);
-    tags[d->id] = corners;
-  }
-  for (const auto& [id, count] : seen)
-    if (count > 1) tags.erase(id);
-  apriltag_detections_destroy(detections);
-  apriltag_detector_destroy(detector);
-  if (target.family() == "tag36h11") tag36h11_destroy(family); else tagStandard41h12_destroy(family);
-  return tags;
-}
-
-}  // namespace
 
 ImageDetections DetectThroughVirtualViews(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& guess,
                                           const ImageDetections& raw) {
@@ -151,7 +122,7 @@ ImageDetections DetectThroughVirtualViews(const CalibrationTarget& target, const
       const VirtualView virtual_view(guess, cache.camera_from_mirror_rotation * ViewFrame(forward_m, -Eigen::Vector3d::UnitZ()),
                                      centre, focal, kSize, kSize);
       const cv::Mat view = virtual_view.Resample(grey, cv::INTER_LINEAR);
-      for (const auto& [id, corners] : DetectTags(target, view)) {
+      for (const auto& [id, corners] : DetectTags(target, view, nullptr)) {
         std::array<Eigen::Vector2d, 4> omni;
         bool inside = true;
         Eigen::Vector2d mean = Eigen::Vector2d::Zero();

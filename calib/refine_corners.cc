@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 
+#include "calib/bilinear.h"
 #include "calib/virtual_view.h"
 
 namespace omnical {
@@ -45,14 +46,7 @@ bool SubPixel(const cv::Mat& image, const Eigen::Vector2d& start, double window_
   return std::isfinite(refined->x()) && std::isfinite(refined->y()) && (*refined - start).norm() <= 0.5 * half;
 }
 
-// Bilinear sample of an 8-bit image; NaN outside.
-double Sample(const cv::Mat& image, const Eigen::Vector2d& at) {
-  const int x0 = static_cast<int>(std::floor(at.x())), y0 = static_cast<int>(std::floor(at.y()));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= image.cols || y0 + 1 >= image.rows) return NAN;
-  const double a = at.x() - x0, b = at.y() - y0;
-  return (1 - a) * (1 - b) * image.at<uint8_t>(y0, x0) + a * (1 - b) * image.at<uint8_t>(y0, x0 + 1) +
-         (1 - a) * b * image.at<uint8_t>(y0 + 1, x0) + a * b * image.at<uint8_t>(y0 + 1, x0 + 1);
-}
+double Sample(const cv::Mat& image, const Eigen::Vector2d& at) { return Bilinear<uint8_t>(image, at.x(), at.y()); }
 
 // Where an edge crosses the profile base + s * normal, s from -inside_px (ink) to
 // +outside_px (paper): the crossing of the level halfway between the ink level and the

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <random>
 
+#include "calib/bilinear.h"
+
 namespace omnical {
 
 namespace {
@@ -14,13 +16,7 @@ namespace {
 constexpr int kRays = 720;
 constexpr double kInlierPx = 3.0;
 
-double Sample(const cv::Mat& image, double x, double y) {
-  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= image.cols || y0 + 1 >= image.rows) return NAN;
-  const double a = x - x0, b = y - y0;
-  return (1 - a) * (1 - b) * image.at<float>(y0, x0) + a * (1 - b) * image.at<float>(y0, x0 + 1) +
-         (1 - a) * b * image.at<float>(y0 + 1, x0) + a * b * image.at<float>(y0 + 1, x0 + 1);
-}
+double Sample(const cv::Mat& image, double x, double y) { return Bilinear<float>(image, x, y); }
 
 // Per ray from `centre`, the radius in [min_r, max_r] with the largest inside-minus-outside
 // step; rays that find no drop of at least 10 grey levels give nothing.

@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include "calib/bilinear.h"
+
 namespace omnical {
 
 namespace {
@@ -47,18 +49,14 @@ Eigen::Vector2d VirtualView::ToView(const Eigen::Vector3d& direction_in_camera) 
 
 bool VirtualView::ToOmni(const Eigen::Vector2d& view_px, Eigen::Vector2d* omni_px) const {
   const double x = view_px.x(), y = view_px.y();
-  if (!std::isfinite(x) || !std::isfinite(y)) return false;
+  const double u = Bilinear<float>(map_x_, x, y), v = Bilinear<float>(map_y_, x, y);
+  if (!std::isfinite(u) || !std::isfinite(v)) return false;
+  // A neighbour whose ray missed the mirror holds -1: no omni pixel there.
   const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= width_px() || y0 + 1 >= height_px()) return false;
   for (int dy = 0; dy < 2; ++dy)
     for (int dx = 0; dx < 2; ++dx)
       if (map_x_.at<float>(y0 + dy, x0 + dx) < 0.0f) return false;
-  const double a = x - x0, b = y - y0;
-  auto interpolate = [&](const cv::Mat& map) {
-    return (1 - a) * (1 - b) * map.at<float>(y0, x0) + a * (1 - b) * map.at<float>(y0, x0 + 1) +
-           (1 - a) * b * map.at<float>(y0 + 1, x0) + a * b * map.at<float>(y0 + 1, x0 + 1);
-  };
-  *omni_px = Eigen::Vector2d(interpolate(map_x_), interpolate(map_y_));
+  *omni_px = Eigen::Vector2d(u, v);
   return true;
 }
 
