@@ -15,10 +15,12 @@ Command TargetCommand();
 Command RenderCommand();
 Command DetectCommand();
 Command CalibrateCommand();
+Command RemapCommand();
+Command UnwarpCommand();
 
 inline std::vector<Command> AllCommands() {
   return {ProjectCommand(), UnprojectCommand(), CharacterizeCommand(), ParallaxCommand(), TargetCommand(),
-          RenderCommand(),  DetectCommand(),    CalibrateCommand()};
+          RenderCommand(),  DetectCommand(),    CalibrateCommand(), RemapCommand(),    UnwarpCommand()};
 }
 
 }  // namespace omnical::cli

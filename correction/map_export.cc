@@ -1,0 +1,127 @@
+#include "correction/map_export.h"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <filesystem>
+#include <unistd.h>
+
+#include "model/atomic_write.h"
+#include "model/input_error.h"
+
+namespace omnical {
+namespace {
+
+cv::Mat MapMat(const RemapTable& table, const std::vector<float>& values) {
+  return cv::Mat(table.height, table.width, CV_32F, const_cast<float*>(values.data()));
+}
+
+// cv::FileStorage picks its format from the file name, so the temporary file keeps the
+// target's name as its suffix.
+void WriteFileStorageAtomically(const std::string& path, const std::function<void(cv::FileStorage&)>& write) {
+  const std::filesystem::path target(path);
+  const std::filesystem::path temporary =
+      target.parent_path() / (".tmp" + std::to_string(::getpid()) + "-" + target.filename().string());
+  try {
+    cv::FileStorage storage(temporary.string(), cv::FileStorage::WRITE);
+    if (!storage.isOpened()) throw InputError(InputMessage(path, "", "cannot be written"));
+    write(storage);
+    storage.release();
+    std::filesystem::rename(temporary, target);
+  } catch (const cv::Exception& e) {
+    std::filesystem::remove(temporary);
+    throw InputError(InputMessage(path, "", std::string("cannot be written: ") + e.err));
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw;
+  }
+}
+
+void WritePgm16(const RemapTable& table, const std::vector<float>& values, const std::string& path) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "P5\n" << table.width << ' ' << table.height << "\n65535\n";
+    std::vector<unsigned char> bytes(2 * values.size());
+    for (size_t i = 0; i < values.size(); ++i) {
+      const float value = values[i];
+      const long rounded = value < -0.5f ? 65535L : std::lround(value);  // -1: no mirror
+      const uint16_t word = static_cast<uint16_t>(std::min(65535L, std::max(0L, rounded)));
+      bytes[2 * i] = static_cast<unsigned char>(word >> 8);  // PGM is big-endian
+      bytes[2 * i + 1] = static_cast<unsigned char>(word & 0xff);
+    }
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  });
+}
+
+void WriteNpyFloat32(const RemapTable& table, const std::vector<float>& values, const std::string& path) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + std::to_string(table.height) + ", " +
+                         std::to_string(table.width) + "), }";
+    // Magic (6) + version (2) + length (2) + header + '\n' padded to a multiple of 64.
+    const size_t unpadded = 10 + header.size() + 1;
+    header.append((64 - unpadded % 64) % 64, ' ');
+    header += '\n';
+    out.write("\x93NUMPY\x01\x00", 8);
+    const uint16_t length = static_cast<uint16_t>(header.size());
+    const char length_bytes[2] = {static_cast<char>(length & 0xff), static_cast<char>(length >> 8)};
+    out.write(length_bytes, 2);
+    out << header;
+    static_assert(sizeof(float) == 4, "float32");
+    for (float value : values) {  // little-endian, whatever the host
+      uint32_t bits;
+      std::memcpy(&bits, &value, 4);
+      const char b[4] = {char(bits & 0xff), char((bits >> 8) & 0xff), char((bits >> 16) & 0xff), char(bits >> 24)};
+      out.write(b, 4);
+    }
+  });
+}
+
+}  // namespace
+
+void WriteOpenCvMaps(const RemapTable& table, const std::string& float_path, const std::string& fixed_path) {
+  const cv::Mat map_x = MapMat(table, table.map_x), map_y = MapMat(table, table.map_y);
+  WriteFileStorageAtomically(float_path, [&](cv::FileStorage& fs) {
+    fs << "map_x" << map_x << "map_y" << map_y;
+  });
+  cv::Mat map1, map2;
+  cv::convertMaps(map_x, map_y, map1, map2, CV_16SC2);
+  WriteFileStorageAtomically(fixed_path, [&](cv::FileStorage& fs) { fs << "map1" << map1 << "map2" << map2; });
+}
+
+void WriteFfmpegMaps(const RemapTable& table, const std::string& xmap_path, const std::string& ymap_path) {
+  WritePgm16(table, table.map_x, xmap_path);
+  WritePgm16(table, table.map_y, ymap_path);
+}
+
+void WriteNpyMaps(const RemapTable& table, const std::string& x_path, const std::string& y_path) {
+  WriteNpyFloat32(table, table.map_x, x_path);
+  WriteNpyFloat32(table, table.map_y, y_path);
+}
+
+RemapTable ReadOpenCvMaps(const std::string& float_path) {
+  cv::Mat map_x, map_y;
+  try {
+    cv::FileStorage fs(float_path, cv::FileStorage::READ);
+    if (!fs.isOpened()) throw InputError(InputMessage(float_path, "", "cannot be read (missing or not an OpenCV storage file)"));
+    fs["map_x"] >> map_x;
+    fs["map_y"] >> map_y;
+  } catch (const cv::Exception& e) {
+    throw InputError(InputMessage(float_path, "", std::string("cannot be parsed: ") + e.err));
+  }
+  if (map_x.empty() || map_y.empty()) throw InputError(InputMessage(float_path, "map_x/map_y", "missing"));
+  if (map_x.type() != CV_32F || map_y.type() != CV_32F || map_x.size() != map_y.size())
+    throw InputError(InputMessage(float_path, "map_x/map_y", "not two float maps of one size"));
+  RemapTable table;
+  table.width = map_x.cols;
+  table.height = map_x.rows;
+  table.map_x.assign(map_x.begin<float>(), map_x.end<float>());
+  table.map_y.assign(map_y.begin<float>(), map_y.end<float>());
+  for (size_t i = 0; i < table.map_x.size(); ++i) table.valid_pixels += table.map_x[i] >= -0.5f && table.map_y[i] >= -0.5f;
+  return table;
+}
+
+}  // namespace omnical

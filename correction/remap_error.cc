@@ -1,0 +1,82 @@
+#include "correction/remap_error.h"
+
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <thread>
+
+namespace omnical {
+
+ObjectSurface ObjectAtDistance(const ObjectSurface& table_surface, double distance_mm) {
+  ObjectSurface object = table_surface;
+  if (!(distance_mm > 0.0) || !std::isfinite(distance_mm)) {
+    object.kind = ObjectSurface::Kind::kInfinity;
+    return object;
+  }
+  if (object.kind == ObjectSurface::Kind::kInfinity) object.kind = ObjectSurface::Kind::kSphere;
+  object.distance_mm = distance_mm;
+  return object;
+}
+
+bool RemapDisplacementPx(const Sensor& sensor, const RemapSettings& settings, const ObjectSurface& object, double col,
+                         double row, double* error_px) {
+  const ProjectionCache& cache = sensor.cache();
+  const Eigen::Vector3d viewpoint(0.0, 0.0, settings.v0_mm);
+  const double far_mm = InfinityDistanceMm(sensor);
+  Eigen::Vector3d direction, object_point, shown_point;
+  if (!settings.screen.Direction(col, row, &direction) || !object.PointAlong(viewpoint, direction, far_mm, &object_point))
+    return false;
+  Eigen::Vector2d omni_pixel, shown_pixel;
+  if (sensor.Project(cache.camera_from_mirror_rotation * object_point + cache.camera_from_mirror_translation,
+                     &omni_pixel) != ProjectionStatus::kOk)
+    return false;
+  Eigen::Vector3d origin_in_camera, ray_in_camera;
+  if (sensor.Unproject(omni_pixel, &origin_in_camera, &ray_in_camera) != ProjectionStatus::kOk) return false;
+  const Eigen::Matrix3d& mirror_from_camera = cache.camera_from_mirror_rotation.transpose();
+  const Eigen::Vector3d origin = mirror_from_camera * (origin_in_camera - cache.camera_from_mirror_translation);
+  const Eigen::Vector3d ray = (mirror_from_camera * ray_in_camera).normalized();
+  if (!settings.surface.IntersectRay(viewpoint, origin, ray, far_mm, &shown_point)) return false;
+  if (!settings.screen.PixelOf(shown_point - viewpoint, &shown_pixel)) return false;
+  Eigen::Vector2d offset = shown_pixel - Eigen::Vector2d(col, row);
+  // A 360-degree screen wraps: the short way round.
+  if (settings.screen.type == VirtualScreen::Type::kPanorama || settings.screen.type == VirtualScreen::Type::kLonLat)
+    offset.x() -= settings.screen.width_px * std::round(offset.x() / settings.screen.width_px);
+  *error_px = offset.norm();
+  return std::isfinite(*error_px);
+}
+
+RemapErrorStats RemapErrorAt(const Sensor& sensor, const RemapSettings& settings, const ObjectSurface& object,
+                             int stride_px) {
+  RemapErrorStats stats;
+  stats.object_distance_mm = object.kind == ObjectSurface::Kind::kInfinity ? HUGE_VAL : object.distance_mm;
+  const int step = std::max(1, stride_px);
+  const int rows = (settings.screen.height_px + step - 1) / step;
+  std::atomic<int> next{0};
+  std::mutex mutex;
+  double sum_squares = 0.0;
+  auto work = [&]() {
+    long count = 0;
+    double max = 0.0, squares = 0.0;
+    for (int r = next++; r < rows; r = next++) {
+      for (int col = step / 2; col < settings.screen.width_px; col += step) {
+        double error = 0.0;
+        if (!RemapDisplacementPx(sensor, settings, object, col, r * step + step / 2, &error)) continue;
+        ++count;
+        max = std::max(max, error);
+        squares += error * error;
+      }
+    }
+    std::lock_guard<std::mutex> lock(mutex);
+    stats.samples += count;
+    stats.max_px = std::max(stats.max_px, max);
+    sum_squares += squares;
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < std::max(1, settings.threads); ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& thread : pool) thread.join();
+  stats.rms_px = stats.samples > 0 ? std::sqrt(sum_squares / stats.samples) : 0.0;
+  return stats;
+}
+
+}  // namespace omnical

@@ -1,0 +1,52 @@
+// Remap tables: for every pixel of a virtual screen, the omni-image pixel to sample. The
+// output pixel's direction from V0 meets the object surface at a 3-D point whose exact
+// (non-central) projection is the table entry, so the table is exact for objects on that
+// surface and off by the seed's Eq. 23 error elsewhere.
+//
+// Speed: an axial sensor with a rotationally symmetric surface and a panorama or lonlat
+// screen has one projection per row up to a rotation: the row is projected at four
+// azimuths and every column follows as u = cu + au cos(phi), v = cv + av sin(phi) (exact
+// for the lens models, which scale x and y separately about a centre; tested against the
+// per-pixel path to 1e-6 px). Everything else goes through the batch projector, rows spread
+// over threads.
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include "correction/object_surface.h"
+#include "correction/virtual_screen.h"
+#include "model/sensor.h"
+
+namespace omnical {
+
+struct RemapTable {
+  int width = 0, height = 0;
+  // Row-major omni-image pixel (centre of pixel (0, 0) at (0, 0)); -1 where the output
+  // pixel sees no mirror (cv::remap then fills it with the border value).
+  std::vector<float> map_x, map_y;
+  long valid_pixels = 0;
+  bool used_axial_symmetry = false;
+};
+
+struct RemapSettings {
+  VirtualScreen screen;
+  ObjectSurface surface;
+  double v0_mm = 0.0;  // V0 as z on the mirror axis, mirror frame
+  int threads = 1;
+  bool allow_symmetry = true;  // false: per-pixel projection everywhere (the reference)
+};
+
+// "Distant" for an infinity surface: 1e7 rim radii from V0, where the viewpoint spread
+// (mm) is far below 1e-6 px.
+double InfinityDistanceMm(const Sensor& sensor);
+
+// The object point (mirror frame) of an output point, false where there is none.
+bool RemapObjectPoint(const Sensor& sensor, const RemapSettings& settings, double col, double row,
+                      Eigen::Vector3d* point_in_mirror);
+
+// progress(rows) is called as rows finish, from any thread.
+RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings,
+                           const std::function<void(long)>& progress = nullptr);
+
+}  // namespace omnical

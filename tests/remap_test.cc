@@ -1,0 +1,254 @@
+// Virtual screens and remap tables (correction issue): the screen geometry, the exactness
+// of the tables for objects on their surface, the axial shortcut against the per-pixel
+// path, and the error for objects elsewhere against the independent angle geometry.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <random>
+
+#include "correction/map_export.h"
+#include "correction/remap_error.h"
+#include "correction/remap_table.h"
+#include "correction/viewpoint_error.h"
+#include "model/input_error.h"
+#include "model/optics.h"
+#include "test_sensors.h"
+
+namespace omnical {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+Sensor Shipped(const std::string& name) {
+  return LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/" + name + ".yaml");
+}
+
+std::vector<VirtualScreen> AllScreens() {
+  VirtualScreen panorama;
+  panorama.type = VirtualScreen::Type::kPanorama;
+  panorama.width_px = 720, panorama.height_px = 160;
+  panorama.azimuth0_deg = 37.0, panorama.elevation_top_deg = 35.0, panorama.elevation_bottom_deg = -50.0;
+  VirtualScreen lonlat = panorama;
+  lonlat.type = VirtualScreen::Type::kLonLat;
+  VirtualScreen perspective;
+  perspective.type = VirtualScreen::Type::kPerspective;
+  perspective.width_px = 320, perspective.height_px = 240;
+  perspective.pan_deg = 130.0, perspective.tilt_deg = -10.0, perspective.roll_deg = 7.0, perspective.hfov_deg = 70.0;
+  VirtualScreen equiangular;
+  equiangular.type = VirtualScreen::Type::kEquiangular;
+  equiangular.width_px = equiangular.height_px = 300;
+  equiangular.omega_max_deg = 125.0;
+  return {panorama, lonlat, perspective, equiangular};
+}
+
+// Direction and PixelOf are inverses over every screen.
+TEST(VirtualScreen, DirectionAndPixelRoundTrip) {
+  std::mt19937 random(4);
+  for (const VirtualScreen& screen : AllScreens()) {
+    ASSERT_EQ(screen.Check(), "");
+    std::uniform_real_distribution<double> col(-0.5, screen.width_px - 0.5), row(-0.5, screen.height_px - 0.5);
+    for (int i = 0; i < 500; ++i) {
+      const Eigen::Vector2d pixel(col(random), row(random));
+      Eigen::Vector3d direction;
+      if (!screen.Direction(pixel.x(), pixel.y(), &direction)) continue;
+      EXPECT_NEAR(direction.norm(), 1.0, 1e-12);
+      Eigen::Vector2d back;
+      ASSERT_TRUE(screen.PixelOf(3.7 * direction, &back)) << ScreenTypeName(screen.type);
+      EXPECT_LT((back - pixel).norm(), 1e-8) << ScreenTypeName(screen.type) << " at " << pixel.transpose();
+    }
+  }
+}
+
+// The documented conventions: panoramas run to decreasing azimuth, a perspective view's
+// "right" is forward x z, equiangular radius is proportional to Omega.
+TEST(VirtualScreen, FollowsTheDocumentedConventions) {
+  std::vector<VirtualScreen> screens = AllScreens();
+  Eigen::Vector3d a, b;
+  screens[0].Direction(-0.5, 79.5, &a);
+  EXPECT_NEAR(std::atan2(a.y(), a.x()), 37.0 * kDeg, 1e-12);
+  screens[0].Direction(179.5, 79.5, &b);  // a quarter turn on
+  EXPECT_NEAR(std::atan2(b.y(), b.x()), (37.0 - 90.0) * kDeg, 1e-12);
+  screens[1].Direction(10.0, -0.5, &a);
+  EXPECT_NEAR(std::asin(a.z()), 35.0 * kDeg, 1e-12);  // lonlat: elevation at the top edge
+  screens[0].Direction(10.0, 159.5, &a);
+  EXPECT_NEAR(std::asin(a.z()), -50.0 * kDeg, 1e-12);  // panorama: at the bottom edge
+  VirtualScreen level = screens[2];
+  level.roll_deg = 0.0;
+  level.Direction(0.5 * (level.width_px - 1), 0.5 * (level.height_px - 1), &a);
+  EXPECT_NEAR(std::atan2(a.y(), a.x()), 130.0 * kDeg, 1e-12);
+  EXPECT_NEAR(std::asin(a.z()), -10.0 * kDeg, 1e-12);
+  level.Direction(level.width_px - 0.5, 0.5 * (level.height_px - 1), &b);  // the right edge
+  EXPECT_NEAR(std::acos(a.dot(b)), 35.0 * kDeg, 1e-9);
+  EXPECT_LT(std::atan2(b.y(), b.x()), 130.0 * kDeg);  // right is clockwise seen from +z
+  level.Direction(0.5 * (level.width_px - 1), level.height_px - 0.5, &b);  // the bottom edge
+  EXPECT_LT(b.z(), a.z());                                                  // is lower
+  EXPECT_NEAR(level.MirrorFromView().determinant(), 1.0, 1e-12);            // not mirror-imaged
+  screens[3].Direction(0.5 * 299 + 75.0, 0.5 * 299, &a);  // half way out along +x
+  EXPECT_NEAR(std::acos(-a.z()), 62.5 * kDeg, 1e-12);
+  EXPECT_NEAR(a.y(), 0.0, 1e-12);
+}
+
+TEST(VirtualScreen, RejectsUnusableGeometry) {
+  VirtualScreen screen = AllScreens()[0];
+  screen.elevation_top_deg = -60.0;
+  EXPECT_NE(screen.Check().find("elevation"), std::string::npos);
+  screen = AllScreens()[2];
+  screen.hfov_deg = 180.0;
+  EXPECT_NE(screen.Check().find("hfov"), std::string::npos);
+  screen.width_px = 0;
+  EXPECT_NE(screen.Check().find("size"), std::string::npos);
+  ObjectSurface surface;
+  surface.kind = ObjectSurface::Kind::kSphere;
+  surface.distance_mm = 0.0;
+  EXPECT_NE(surface.Check().find("distance"), std::string::npos);
+  surface.distance_mm = NAN;
+  EXPECT_NE(surface.Check().find("distance"), std::string::npos);
+}
+
+// Every table entry is the exact projection of its object point (scalar solver vs the
+// batch one the table uses), for aligned and misaligned sensors and every surface kind;
+// 2e-4 px allows for the float storage of a ~1000-px coordinate (ulp 6e-5).
+TEST(RemapTable, EntriesAreExactProjectionsOfTheObjectPoints) {
+  for (const char* name : {"ohte-sph", "ohte-sph-misaligned", "ohte-edi"}) {
+    const Sensor sensor = Shipped(name);
+    for (auto kind : {ObjectSurface::Kind::kInfinity, ObjectSurface::Kind::kSphere, ObjectSurface::Kind::kCylinder,
+                      ObjectSurface::Kind::kPlane}) {
+      for (const VirtualScreen& screen : AllScreens()) {
+        RemapSettings settings;
+        settings.screen = screen;
+        settings.surface.kind = kind;
+        settings.surface.distance_mm = 7.0 * sensor.rim_radius_mm();
+        settings.surface.plane_normal = Eigen::Vector3d(0.3, 0.2, -1.0).normalized();
+        settings.v0_mm = 11.0;
+        settings.threads = 2;
+        const RemapTable table = BuildRemapTable(sensor, settings);
+        long checked = 0;
+        for (int v = 0; v < table.height; v += 7) {
+          for (int u = 0; u < table.width; u += 11) {
+            Eigen::Vector3d point;
+            Eigen::Vector2d pixel;
+            const bool has_point = RemapObjectPoint(sensor, settings, u, v, &point);
+            const ProjectionStatus status =
+                has_point ? sensor.Project(sensor.cache().camera_from_mirror_rotation * point +
+                                               sensor.cache().camera_from_mirror_translation,
+                                           &pixel)
+                          : ProjectionStatus::kBehindMirror;
+            const size_t i = static_cast<size_t>(v) * table.width + u;
+            if (status != ProjectionStatus::kOk) {
+              EXPECT_EQ(table.map_x[i], -1.0f) << name << " " << u << "," << v;
+              continue;
+            }
+            ++checked;
+            EXPECT_NEAR(table.map_x[i], pixel.x(), 2e-4) << name << " " << ScreenTypeName(screen.type) << " " << u << "," << v;
+            EXPECT_NEAR(table.map_y[i], pixel.y(), 2e-4) << name << " " << ScreenTypeName(screen.type) << " " << u << "," << v;
+          }
+        }
+        EXPECT_GT(checked, 50) << name << " " << ScreenTypeName(screen.type) << " " << SurfaceKindName(kind);
+      }
+    }
+  }
+}
+
+// The axial shortcut (one projection per row, then rotation) gives the per-pixel tables.
+TEST(RemapTable, AxialShortcutMatchesPerPixelProjection) {
+  for (const char* name : {"ohte-sph", "ohte-edi", "ohte-svp"}) {
+    const Sensor sensor = Shipped(name);
+    for (auto kind : {ObjectSurface::Kind::kInfinity, ObjectSurface::Kind::kSphere, ObjectSurface::Kind::kCylinder}) {
+      for (int s = 0; s < 2; ++s) {
+        RemapSettings settings;
+        settings.screen = AllScreens()[s];
+        settings.surface.kind = kind;
+        settings.surface.distance_mm = 5.0 * sensor.rim_radius_mm();
+        settings.v0_mm = 8.0;
+        const RemapTable fast = BuildRemapTable(sensor, settings);
+        settings.allow_symmetry = false;
+        const RemapTable exact = BuildRemapTable(sensor, settings);
+        ASSERT_TRUE(fast.used_axial_symmetry);
+        ASSERT_FALSE(exact.used_axial_symmetry);
+        EXPECT_EQ(fast.valid_pixels, exact.valid_pixels) << name;
+        double worst = 0.0;
+        for (size_t i = 0; i < fast.map_x.size(); ++i) {
+          if (exact.map_x[i] < 0.0f) continue;
+          worst = std::max({worst, double(std::abs(fast.map_x[i] - exact.map_x[i])),
+                            double(std::abs(fast.map_y[i] - exact.map_y[i]))});
+        }
+        EXPECT_LT(worst, 2e-4) << name << " " << SurfaceKindName(kind);  // float storage, as above
+      }
+    }
+  }
+}
+
+// A table is exact at its own distance; an infinity table seen in a lonlat view with
+// equal scales along both axes is off by the angle between the object's direction from V0
+// and the ray of the pixel it is imaged at (computed here from Project/Unproject alone),
+// and that worst error over the field is the seed's Eq. 23 figure (4.75 px at n = 7 in
+// the omni image of the seed's sphere; here in degrees against the curve's worst angle,
+// 15 %: the curve measures D from the reflection point, the map from V0).
+TEST(RemapError, ZeroOnTheSurfaceAndEquation23Elsewhere) {
+  const Sensor sensor = Shipped("ohte-sph");
+  const double rim = sensor.rim_radius_mm(), distance = 7.0 * rim;
+  const std::vector<FieldSample> field = AnalyzeField(sensor, 540, distance);
+  RemapSettings settings;
+  settings.screen.type = VirtualScreen::Type::kLonLat;
+  settings.screen.width_px = 1440, settings.screen.height_px = 360;  // 4 px per degree both ways
+  settings.screen.elevation_top_deg = 35.0, settings.screen.elevation_bottom_deg = -55.0;
+  settings.v0_mm = BestViewpointMm(field, distance);
+  settings.surface.kind = ObjectSurface::Kind::kSphere;
+  settings.surface.distance_mm = distance;
+  const ObjectSurface object = ObjectAtDistance(settings.surface, distance);
+  const RemapErrorStats own = RemapErrorAt(sensor, settings, object, 23);
+  EXPECT_GT(own.samples, 500);
+  EXPECT_LT(own.max_px, 1e-6);
+
+  settings.surface.kind = ObjectSurface::Kind::kInfinity;
+  double worst_deg = 0.0;
+  for (int row = 1; row < 360; row += 6) {
+    double error_px = 0.0;
+    if (!RemapDisplacementPx(sensor, settings, object, 100.0, row, &error_px)) continue;
+    Eigen::Vector3d direction, origin, ray;
+    settings.screen.Direction(100.0, row, &direction);
+    Eigen::Vector2d pixel;
+    ASSERT_EQ(sensor.Project(Eigen::Vector3d(0, 0, settings.v0_mm + sensor.cache().camera_from_mirror_translation.z()) +
+                                 distance * direction,
+                             &pixel),
+              ProjectionStatus::kOk);
+    ASSERT_EQ(sensor.Unproject(pixel, &origin, &ray), ProjectionStatus::kOk);
+    const double angle_deg = std::acos(std::min(1.0, direction.dot(ray.normalized()))) / kDeg;
+    EXPECT_NEAR(error_px / 4.0, angle_deg, 1e-3 + 1e-3 * angle_deg) << "row " << row;
+    worst_deg = std::max(worst_deg, angle_deg);
+  }
+  const ParallaxCurve curve = ComputeParallaxCurve(field, distance, settings.v0_mm);
+  std::printf("worst %.4f deg over the lonlat column, Eq. 23 curve %.4f deg\n", worst_deg, curve.max_abs_error_deg);
+  EXPECT_NEAR(worst_deg, curve.max_abs_error_deg, 0.15 * curve.max_abs_error_deg);
+}
+
+// The exported files read back to the table (float maps), and the .npy header is what
+// NumPy's format 1.0 expects.
+TEST(MapExport, OpenCvMapsRoundTripAndNpyHeaderIsWellFormed) {
+  const Sensor sensor = Shipped("ohte-sph");
+  RemapSettings settings;
+  settings.screen = AllScreens()[0];
+  const RemapTable table = BuildRemapTable(sensor, settings);
+  const std::string dir = testing::PrivateTempDir();
+  WriteOpenCvMaps(table, dir + "/maps.yml.gz", dir + "/maps_fixed.yml.gz");
+  const RemapTable back = ReadOpenCvMaps(dir + "/maps.yml.gz");
+  ASSERT_EQ(back.width, table.width);
+  ASSERT_EQ(back.height, table.height);
+  EXPECT_EQ(back.valid_pixels, table.valid_pixels);
+  for (size_t i = 0; i < table.map_x.size(); i += 97) EXPECT_EQ(back.map_x[i], table.map_x[i]);
+  WriteNpyMaps(table, dir + "/x.npy", dir + "/y.npy");
+  std::ifstream npy(dir + "/x.npy", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(npy)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 10u);
+  EXPECT_EQ(bytes.substr(0, 8), std::string("\x93NUMPY\x01\x00", 8));
+  const size_t header = static_cast<unsigned char>(bytes[8]) | (static_cast<unsigned char>(bytes[9]) << 8);
+  EXPECT_EQ((10 + header) % 64, 0u);
+  EXPECT_EQ(bytes.size(), 10 + header + 4 * table.map_x.size());
+  EXPECT_NE(bytes.find("'shape': (160, 720)"), std::string::npos);
+  EXPECT_THROW(ReadOpenCvMaps(dir + "/x.npy"), InputError);
+}
+
+}  // namespace
+}  // namespace omnical
