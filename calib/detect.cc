@@ -61,12 +61,18 @@ std::map<int, std::array<Eigen::Vector2d, 4>> DetectTags(const CalibrationTarget
 
 }  // namespace
 
-ImageDetections DetectAprilGrid(const CalibrationTarget& target, const cv::Mat& grey, DetectionStats* stats) {
+ImageDetections DetectAprilGrid(const CalibrationTarget& target, const cv::Mat& grey, DetectionStats* stats,
+                                bool mirrored) {
   if (target.type() != CalibrationTarget::Type::kAprilGrid)
     throw std::invalid_argument("only aprilgrid targets can be detected so far");
+  ImageDetections image;
+  if (!mirrored) {
+    for (const auto& [id, corners] : DetectTags(target, grey, stats))
+      for (int k = 0; k < 4; ++k) image.corners.push_back({4 * id + k, corners[k]});
+    return image;
+  }
   cv::Mat flipped;
   cv::flip(grey, flipped, 1);  // undo the mirror's reversal of handedness
-  ImageDetections image;
   for (const auto& [id, corners] : DetectTags(target, flipped, stats))
     for (int k = 0; k < 4; ++k)  // flip the column back
       image.corners.push_back({4 * id + k, Eigen::Vector2d(grey.cols - 1 - corners[k].x(), corners[k].y())});

@@ -29,7 +29,9 @@ struct DetectionStats {
 
 // Detects the target's tags in an 8-bit grey image (pixel-centre coordinates, as
 // everywhere). Throws std::invalid_argument for another target type.
-ImageDetections DetectAprilGrid(const CalibrationTarget& target, const cv::Mat& grey, DetectionStats* stats = nullptr);
+// `mirrored`: the image is a mirror's (an omni image); false for unwarped virtual screens.
+ImageDetections DetectAprilGrid(const CalibrationTarget& target, const cv::Mat& grey, DetectionStats* stats = nullptr,
+                                bool mirrored = true);
 
 // The checkerboard's inner corners, all or none. Throws std::invalid_argument for
 // another target type.
