@@ -1,6 +1,7 @@
 // The omnical command line: one binary, one subcommand per job (tools/commands.h).
 // Exit codes: 0 success, 2 bad input or usage (one line on stderr), 1 internal error.
 #include <CLI/CLI.hpp>
+#include <opencv2/core/utils/logger.hpp>
 
 #include <iostream>
 #include <map>
@@ -9,6 +10,8 @@
 #include "tools/commands.h"
 
 int main(int argc, char** argv) {
+  // Unreadable inputs get omnical's one-line errors; OpenCV's own warnings would add lines.
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
   using namespace omnical;
   CLI::App app{"omnical: calibration and correction of non-central catadioptric cameras"};
   app.require_subcommand(1);
