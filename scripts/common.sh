@@ -14,6 +14,7 @@ omnical_packages=(
   libeigen3-dev libceres-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libboost-dev
   libopencv-dev libopencv-contrib-dev libapriltag-dev
   libgtest-dev libgmock-dev libbenchmark-dev python3
+  ffmpeg python3-numpy
 )
 
 install_dependencies() {

@@ -2,11 +2,11 @@
 # Installs what is missing, builds omnical in Release and runs the main job on the bundled
 # synthetic data. Today: (0) the main job on a misaligned spherical mirror: render 8 views
 # with ground truth, detect the aprilgrid, calibrate from the design guess, parallax report
-# of the result; then for each of the seed paper's three mirrors, (1) the sensor model:
+# of the result, remap tables exact at n = 7 exported for OpenCV/ffmpeg/NumPy, a view
+# unwarped through them and their error at other distances; then for each of the seed paper's three mirrors, (1) the sensor model:
 # unproject a pixel grid to rays, put objects 7 mirror radii away along them (the paper's
 # near case) and project them back exactly; (2) the paper's optics evaluation
-# (characterize); (3) the parallax report for objects at n = 7 (parallax). Remap export
-# joins as its issue lands.
+# (characterize); (3) the parallax report for objects at n = 7 (parallax).
 # Output: demo-out/ (or $1).
 set -euo pipefail
 omnical_build_kind=demo
@@ -23,6 +23,14 @@ mkdir -p "$out"
   --detections "$out/detections.json" --sensor "$omnical_root/datasets-synthetic/sensors/ohte-sph-misaligned-guess.yaml" \
   --out "$out/calibration"
 "$omnical" parallax --sensor "$out/calibration/sensor.yaml" --n 7 --out "$out/calibration/parallax-n7"
+# Remap tables from the calibrated sensor, exact for objects 7 rim radii away, for OpenCV,
+# ffmpeg and NumPy; one rendered image unwarped through them; their error elsewhere.
+"$omnical" remap --sensor "$out/calibration/sensor.yaml" --view panorama --n 7 --format opencv,ffmpeg,npy \
+  --out "$out/calibration/remap-n7"
+"$omnical" unwarp --maps "$out/calibration/remap-n7" \
+  --input "$out/render/near-front.png" \
+  --out "$out/calibration/remap-n7/near-front-panorama.png"
+"$omnical" parallax --maps "$out/calibration/remap-n7" --out "$out/calibration/remap-n7/error"
 
 for mirror in ohte-sph ohte-edi ohte-svp; do
   sensor="$omnical_root/datasets-synthetic/sensors/$mirror.yaml"
