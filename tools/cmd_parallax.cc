@@ -67,10 +67,11 @@ void RunForMaps(const Options& options, const Context& context) {
   char title[200];
   const std::string made_for = settings.surface.kind == ObjectSurface::Kind::kInfinity
                                    ? std::string("infinity")
-                                   : std::string(SurfaceKindName(settings.surface.kind)) + " at n = " +
+                                   : "a " + std::string(SurfaceKindName(settings.surface.kind)) + " at n = " +
                                          std::to_string(settings.surface.distance_mm / rim).substr(0, 5);
-  std::snprintf(title, sizeof title, "%s %dx%d made for objects at %s: error elsewhere", ScreenTypeName(settings.screen.type),
-                settings.screen.width_px, settings.screen.height_px, made_for.c_str());
+  std::snprintf(title, sizeof title, "%s %dx%d made for objects %s%s: error elsewhere", ScreenTypeName(settings.screen.type),
+                settings.screen.width_px, settings.screen.height_px,
+                settings.surface.kind == ObjectSurface::Kind::kInfinity ? "at " : "on ", made_for.c_str());
   PlotPanel panel{title, "log10 n (object distance from V0 in mirror rim radii)", "error (output px)"};
   panel.series.push_back({"max", log_n, max_px, SeriesColor(0)});
   panel.series.push_back({"rms", log_n, rms_px, SeriesColor(1)});

@@ -134,13 +134,13 @@ void Run(const Options& options, const Context& context) {
   WriteOutput((dir / "maps.json").string(), [&](std::ostream& out) { out << j.dump(2) << '\n'; });
 
   if (!context.quiet) {
+    char objects[96] = "at infinity";
+    if (settings.surface.kind != ObjectSurface::Kind::kInfinity)
+      std::snprintf(objects, sizeof objects, "on a %s at %.1f mm (n = %.3g)", SurfaceKindName(settings.surface.kind),
+                    settings.surface.distance_mm, settings.surface.distance_mm / rim);
     std::printf("%s %dx%d, objects %s, V0 = %.3f mm: %.1f%% of pixels see the mirror, %.3f s%s -> %s\n",
                 ScreenTypeName(settings.screen.type), table.width, table.height,
-                settings.surface.kind == ObjectSurface::Kind::kInfinity
-                    ? "at infinity"
-                    : (std::string("on a ") + SurfaceKindName(settings.surface.kind) + " at " +
-                       std::to_string(settings.surface.distance_mm) + " mm")
-                          .c_str(),
+                objects,
                 settings.v0_mm, 100.0 * valid_fraction, seconds, table.used_axial_symmetry ? " (axial symmetry)" : "",
                 options.out_dir.c_str());
     std::printf("  exact to %.2g px; error at other distances (max output px):", exactness_px);
