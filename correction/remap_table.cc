@@ -50,6 +50,29 @@ RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, 
   table.used_axial_symmetry =
       settings.allow_symmetry && sensor.is_axial() && cylindrical_screen && settings.surface.IsAxiallySymmetric();
   std::atomic<long> valid{0};
+  // Every pixel of row v through the batch projector.
+  auto project_row = [&](int v) {
+    Eigen::Matrix3Xd points(3, table.width);
+    std::vector<char> has_point(table.width, 0);
+    for (int u = 0; u < table.width; ++u) {
+      Eigen::Vector3d point;
+      has_point[u] = RemapObjectPoint(sensor, settings, u, v, &point);
+      points.col(u) = has_point[u] ? Eigen::Vector3d(rotation * point + translation) : Eigen::Vector3d::Zero();
+    }
+    Eigen::Matrix2Xd pixels;
+    std::vector<ProjectionStatus> statuses;
+    sensor.ProjectBatch(points, &pixels, &statuses);
+    long row_valid = 0;
+    for (int u = 0; u < table.width; ++u) {
+      if (!has_point[u] || statuses[u] != ProjectionStatus::kOk) continue;
+      const size_t i = static_cast<size_t>(v) * table.width + u;
+      table.map_x[i] = static_cast<float>(pixels(0, u));
+      table.map_y[i] = static_cast<float>(pixels(1, u));
+      ++row_valid;
+    }
+    valid += row_valid;
+  };
+
 
   if (table.used_axial_symmetry) {
     // Column azimuths: phi(col) = phi(0) - col * step; cos/sin once for all rows.
@@ -91,30 +114,17 @@ RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, 
           ++row_valid;
         }
         valid += row_valid;
+      } else if (ok && std::any_of(statuses.begin(), statuses.end(),
+                                   [](ProjectionStatus s) { return s == ProjectionStatus::kOutsideImage; })) {
+        // A circle cut by the image border: other azimuths may be imaged, so this row
+        // goes pixel by pixel. (Any other failure holds at every azimuth.)
+        project_row(v);
       }
       if (progress) progress(1);
     });
   } else {
     ForEachRow(table.height, settings.threads, [&](int v) {
-      Eigen::Matrix3Xd points(3, table.width);
-      std::vector<char> has_point(table.width, 0);
-      for (int u = 0; u < table.width; ++u) {
-        Eigen::Vector3d point;
-        has_point[u] = RemapObjectPoint(sensor, settings, u, v, &point);
-        points.col(u) = has_point[u] ? Eigen::Vector3d(rotation * point + translation) : Eigen::Vector3d::Zero();
-      }
-      Eigen::Matrix2Xd pixels;
-      std::vector<ProjectionStatus> statuses;
-      sensor.ProjectBatch(points, &pixels, &statuses);
-      long row_valid = 0;
-      for (int u = 0; u < table.width; ++u) {
-        if (!has_point[u] || statuses[u] != ProjectionStatus::kOk) continue;
-        const size_t i = static_cast<size_t>(v) * table.width + u;
-        table.map_x[i] = static_cast<float>(pixels(0, u));
-        table.map_y[i] = static_cast<float>(pixels(1, u));
-        ++row_valid;
-      }
-      valid += row_valid;
+      project_row(v);
       if (progress) progress(1);
     });
   }

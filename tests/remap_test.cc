@@ -180,6 +180,24 @@ TEST(RemapTable, AxialShortcutMatchesPerPixelProjection) {
   }
 }
 
+// A sensor whose image cuts the mirror's circle (a common crop): the shortcut's four
+// azimuths leave the image in some rows, which then go pixel by pixel; same tables.
+TEST(RemapTable, AxialShortcutHandlesACroppedImage) {
+  SensorModel model = Shipped("ohte-sph").model();
+  std::visit([](auto& m) { m.image_height_px = 700; }, model);  // the circle's bottom third cut off
+  const Sensor cropped(model);
+  RemapSettings settings;
+  settings.screen = AllScreens()[0];
+  settings.surface.kind = ObjectSurface::Kind::kInfinity;
+  const RemapTable fast = BuildRemapTable(cropped, settings);
+  settings.allow_symmetry = false;
+  const RemapTable exact = BuildRemapTable(cropped, settings);
+  ASSERT_TRUE(fast.used_axial_symmetry);
+  EXPECT_GT(exact.valid_pixels, 0.5 * exact.width * exact.height);
+  EXPECT_EQ(fast.valid_pixels, exact.valid_pixels);
+  for (size_t i = 0; i < fast.map_x.size(); i += 13) EXPECT_NEAR(fast.map_x[i], exact.map_x[i], 2e-4) << i;
+}
+
 // A table is exact at its own distance; an infinity table seen in a lonlat view with
 // equal scales along both axes is off by the angle between the object's direction from V0
 // and the ray of the pixel it is imaged at (computed here from Project/Unproject alone),
