@@ -7,8 +7,6 @@
 #include <cstdint>
 #include <cstring>
 #include <functional>
-#include <filesystem>
-#include <unistd.h>
 
 #include "model/atomic_write.h"
 #include "model/input_error.h"
@@ -20,26 +18,17 @@ cv::Mat MapMat(const RemapTable& table, const std::vector<float>& values) {
   return cv::Mat(table.height, table.width, CV_32F, const_cast<float*>(values.data()));
 }
 
-// cv::FileStorage picks its format from the file name, so the temporary file keeps the
-// target's name as its suffix.
 void WriteFileStorageAtomically(const std::string& path, const std::function<void(cv::FileStorage&)>& write) {
-  const std::filesystem::path target(path);
-  const std::filesystem::path temporary =
-      target.parent_path() / (".tmp" + std::to_string(::getpid()) + "-" + target.filename().string());
-  try {
-    cv::FileStorage storage(temporary.string(), cv::FileStorage::WRITE);
-    if (!storage.isOpened()) throw InputError(InputMessage(path, "", "cannot be written"));
-    write(storage);
-    storage.release();
-    std::filesystem::rename(temporary, target);
-  } catch (const cv::Exception& e) {
-    std::filesystem::remove(temporary);
-    throw InputError(InputMessage(path, "", std::string("cannot be written: ") + e.err));
-  } catch (...) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    throw;
-  }
+  WriteFileAtomicallyByPath(path, [&](const std::string& temporary) {
+    try {
+      cv::FileStorage storage(temporary, cv::FileStorage::WRITE);
+      if (!storage.isOpened()) throw InputError(InputMessage(path, "", "cannot be written"));
+      write(storage);
+      storage.release();
+    } catch (const cv::Exception& e) {
+      throw InputError(InputMessage(path, "", std::string("cannot be written: ") + e.err));
+    }
+  });
 }
 
 void WritePgm16(const RemapTable& table, const std::vector<float>& values, const std::string& path) {

@@ -1,10 +1,10 @@
 #include "correction/parallax_map.h"
 
+#include "correction/parallel_rows.h"
+
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
-#include <thread>
 
 namespace omnical {
 
@@ -19,32 +19,24 @@ ParallaxMap ComputeParallaxMap(const Sensor& sensor, double object_distance_mm, 
       cache.camera_from_mirror_rotation * Eigen::Vector3d(0.0, 0.0, v0_mm) + cache.camera_from_mirror_translation;
   // "Distant" = far enough that the viewpoint spread (mm) is invisible: 1e7 rim radii.
   const double far_mm = 1e7 * sensor.rim_radius_mm();
-  std::atomic<int> next_row{0};
-  auto work = [&]() {
+  ParallelRows(map.height, threads, [&](int v) {
     Eigen::Matrix2Xd pixels(2, map.width), looked_up;
     Eigen::Matrix3Xd origins, directions, far_points(3, map.width);
     std::vector<ProjectionStatus> ray_status, far_status;
-    for (int v = next_row++; v < map.height; v = next_row++) {
-      for (int u = 0; u < map.width; ++u) pixels.col(u) << u, v;
-      sensor.UnprojectBatch(pixels, &origins, &directions, &ray_status);
-      for (int u = 0; u < map.width; ++u) {
-        const Eigen::Vector3d object = origins.col(u) + object_distance_mm * directions.col(u);
-        far_points.col(u) = viewpoint + far_mm * (object - viewpoint).normalized();
-        if (ray_status[u] != ProjectionStatus::kOk) far_points.col(u).setZero();  // skipped below
-      }
-      sensor.ProjectBatch(far_points, &looked_up, &far_status);
-      for (int u = 0; u < map.width; ++u) {
-        if (ray_status[u] != ProjectionStatus::kOk || far_status[u] != ProjectionStatus::kOk) continue;
-        map.error_px[static_cast<size_t>(v) * map.width + u] =
-            static_cast<float>((looked_up.col(u) - pixels.col(u)).norm());
-      }
-      if (progress) progress(1);
+    for (int u = 0; u < map.width; ++u) pixels.col(u) << u, v;
+    sensor.UnprojectBatch(pixels, &origins, &directions, &ray_status);
+    for (int u = 0; u < map.width; ++u) {
+      const Eigen::Vector3d object = origins.col(u) + object_distance_mm * directions.col(u);
+      far_points.col(u) = viewpoint + far_mm * (object - viewpoint).normalized();
+      if (ray_status[u] != ProjectionStatus::kOk) far_points.col(u).setZero();  // skipped below
     }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& thread : pool) thread.join();
+    sensor.ProjectBatch(far_points, &looked_up, &far_status);
+    for (int u = 0; u < map.width; ++u) {
+      if (ray_status[u] != ProjectionStatus::kOk || far_status[u] != ProjectionStatus::kOk) continue;
+      map.error_px[static_cast<size_t>(v) * map.width + u] = static_cast<float>((looked_up.col(u) - pixels.col(u)).norm());
+    }
+    if (progress) progress(1);
+  });
   for (float e : map.error_px)
     if (std::isfinite(e)) map.max_abs_error_px = std::max(map.max_abs_error_px, double(e));
   return map;

@@ -1,9 +1,9 @@
 #include "correction/pixel_ray_grid.h"
 
+#include "correction/parallel_rows.h"
+
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <thread>
 
 namespace omnical {
 
@@ -14,28 +14,21 @@ PixelRayGrid::PixelRayGrid(const Sensor& sensor, int threads, bool interpolate)
   origins_.resize(static_cast<size_t>(columns) * rows);
   directions_.resize(origins_.size());
   valid_.assign(origins_.size(), 0);
-  std::atomic<int> next{0};
-  auto work = [&]() {
+  ParallelRows(rows, threads, [&](int j) {
     Eigen::Matrix2Xd pixels(2, columns);
     Eigen::Matrix3Xd origins, directions;
     std::vector<ProjectionStatus> statuses;
-    for (int j = next++; j < rows; j = next++) {
-      // Corners on the image border lie half a pixel outside the pixel-centre grid, which
-      // InImage accepts (the image spans [-0.5, W - 0.5]).
-      for (int i = 0; i < columns; ++i) pixels.col(i) << i - 0.5, j - 0.5;
-      sensor_.UnprojectBatch(pixels, &origins, &directions, &statuses);
-      for (int i = 0; i < columns; ++i) {
-        const size_t k = static_cast<size_t>(j) * columns + i;
-        valid_[k] = statuses[i] == ProjectionStatus::kOk;
-        origins_[k] = origins.col(i);
-        directions_[k] = directions.col(i);
-      }
+    // Corners on the image border lie half a pixel outside the pixel-centre grid, which
+    // InImage accepts (the image spans [-0.5, W - 0.5]).
+    for (int i = 0; i < columns; ++i) pixels.col(i) << i - 0.5, j - 0.5;
+    sensor_.UnprojectBatch(pixels, &origins, &directions, &statuses);
+    for (int i = 0; i < columns; ++i) {
+      const size_t k = static_cast<size_t>(j) * columns + i;
+      valid_[k] = statuses[i] == ProjectionStatus::kOk;
+      origins_[k] = origins.col(i);
+      directions_[k] = directions.col(i);
     }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& thread : pool) thread.join();
+  });
 }
 
 ProjectionStatus PixelRayGrid::Ray(double u, double v, Eigen::Vector3d* origin, Eigen::Vector3d* direction) const {

@@ -1,9 +1,10 @@
 #include "correction/remap_error.h"
 
-#include <atomic>
+#include <algorithm>
 #include <cmath>
-#include <mutex>
-#include <thread>
+#include <vector>
+
+#include "correction/parallel_rows.h"
 
 namespace omnical {
 
@@ -51,30 +52,23 @@ RemapErrorStats RemapErrorAt(const Sensor& sensor, const RemapSettings& settings
   stats.object_distance_mm = object.kind == ObjectSurface::Kind::kInfinity ? HUGE_VAL : object.distance_mm;
   const int step = std::max(1, stride_px);
   const int rows = (settings.screen.height_px + step - 1) / step;
-  std::atomic<int> next{0};
-  std::mutex mutex;
-  double sum_squares = 0.0;
-  auto work = [&]() {
-    long count = 0;
-    double max = 0.0, squares = 0.0;
-    for (int r = next++; r < rows; r = next++) {
-      for (int col = step / 2; col < settings.screen.width_px; col += step) {
-        double error = 0.0;
-        if (!RemapDisplacementPx(sensor, settings, object, col, r * step + step / 2, &error)) continue;
-        ++count;
-        max = std::max(max, error);
-        squares += error * error;
-      }
+  std::vector<long> row_count(rows, 0);
+  std::vector<double> row_max(rows, 0.0), row_squares(rows, 0.0);
+  ParallelRows(rows, settings.threads, [&](int r) {
+    for (int col = step / 2; col < settings.screen.width_px; col += step) {
+      double error = 0.0;
+      if (!RemapDisplacementPx(sensor, settings, object, col, r * step + step / 2, &error)) continue;
+      ++row_count[r];
+      row_max[r] = std::max(row_max[r], error);
+      row_squares[r] += error * error;
     }
-    std::lock_guard<std::mutex> lock(mutex);
-    stats.samples += count;
-    stats.max_px = std::max(stats.max_px, max);
-    sum_squares += squares;
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::max(1, settings.threads); ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& thread : pool) thread.join();
+  });
+  double sum_squares = 0.0;
+  for (int r = 0; r < rows; ++r) {
+    stats.samples += row_count[r];
+    stats.max_px = std::max(stats.max_px, row_max[r]);
+    sum_squares += row_squares[r];
+  }
   stats.rms_px = stats.samples > 0 ? std::sqrt(sum_squares / stats.samples) : 0.0;
   return stats;
 }

@@ -1,27 +1,15 @@
 #include "correction/remap_table.h"
 
+#include "correction/parallel_rows.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <thread>
 
 namespace omnical {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-// Runs row(v) for every row, rows handed out to `threads` threads.
-template <typename RowFunction>
-void ForEachRow(int rows, int threads, const RowFunction& row) {
-  std::atomic<int> next{0};
-  auto work = [&]() {
-    for (int v = next++; v < rows; v = next++) row(v);
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& thread : pool) thread.join();
-}
 
 }  // namespace
 
@@ -83,7 +71,7 @@ RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, 
       const double phi = std::atan2(d.y(), d.x());
       cos_phi[u] = std::cos(phi), sin_phi[u] = std::sin(phi);
     }
-    ForEachRow(table.height, settings.threads, [&](int v) {
+    ParallelRows(table.height, settings.threads, [&](int v) {
       // The row's direction at azimuth 0, turned to 0, 90, 180, 270 deg.
       Eigen::Vector3d d;
       screen.Direction(0.0, v, &d);
@@ -123,7 +111,7 @@ RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, 
       if (progress) progress(1);
     });
   } else {
-    ForEachRow(table.height, settings.threads, [&](int v) {
+    ParallelRows(table.height, settings.threads, [&](int v) {
       project_row(v);
       if (progress) progress(1);
     });

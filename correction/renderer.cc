@@ -1,12 +1,12 @@
 #include "correction/renderer.h"
 
+#include "correction/parallel_rows.h"
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <random>
-#include <thread>
 
 namespace omnical {
 namespace {
@@ -57,37 +57,30 @@ cv::Mat RenderView(const Sensor& sensor, const PixelRayGrid& rays, const SceneVi
   const int width = sensor.image_width_px(), height = sensor.image_height_px();
   const int side = static_cast<int>(std::lround(std::sqrt(formation.samples_per_pixel)));
   cv::Mat radiance(height, width, CV_64F);
-  std::atomic<int> next{0};
-  auto work = [&]() {
-    for (int v = next++; v < height; v = next++) {
-      for (int u = 0; u < width; ++u) {
-        double sum = 0.0;
-        for (int j = 0; j < side; ++j) {
-          for (int i = 0; i < side; ++i) {
-            const double su = u - 0.5 + (i + 0.5) / side, sv = v - 0.5 + (j + 0.5) / side;
-            Eigen::Vector3d origin, direction;
-            const ProjectionStatus status = rays.Ray(su, sv, &origin, &direction);
-            if (status != ProjectionStatus::kOk) {
-              sum += status == ProjectionStatus::kOccludedByCamera ? kCameraBody : kRimShadow;
-              continue;
-            }
-            double nearest = HUGE_VAL, value = EnvironmentAt(environment, origin, direction);
-            for (const PlacedTarget& placed : view.targets) {
-              double t = 0.0, reflectance = 0.0;
-              if (HitTarget(placed, origin, direction, &t, &reflectance) && t < nearest) nearest = t, value = reflectance;
-            }
-            sum += value;
+  ParallelRows(height, threads, [&](int v) {
+    for (int u = 0; u < width; ++u) {
+      double sum = 0.0;
+      for (int j = 0; j < side; ++j) {
+        for (int i = 0; i < side; ++i) {
+          const double su = u - 0.5 + (i + 0.5) / side, sv = v - 0.5 + (j + 0.5) / side;
+          Eigen::Vector3d origin, direction;
+          const ProjectionStatus status = rays.Ray(su, sv, &origin, &direction);
+          if (status != ProjectionStatus::kOk) {
+            sum += status == ProjectionStatus::kOccludedByCamera ? kCameraBody : kRimShadow;
+            continue;
           }
+          double nearest = HUGE_VAL, value = EnvironmentAt(environment, origin, direction);
+          for (const PlacedTarget& placed : view.targets) {
+            double t = 0.0, reflectance = 0.0;
+            if (HitTarget(placed, origin, direction, &t, &reflectance) && t < nearest) nearest = t, value = reflectance;
+          }
+          sum += value;
         }
-        radiance.at<double>(v, u) = sum / (side * side);
       }
-      if (progress) progress(1);
+      radiance.at<double>(v, u) = sum / (side * side);
     }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& thread : pool) thread.join();
+    if (progress) progress(1);
+  });
 
   // Vignetting around the image of the axis, normalised by the rim's image radius.
   if (formation.vignetting > 0.0) {

@@ -37,4 +37,22 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
   }
 }
 
+void WriteFileAtomicallyByPath(const std::string& path, const std::function<void(const std::string&)>& write) {
+  const std::filesystem::path target(path);
+  const std::string temp_path =
+      (target.parent_path() / (".tmp" + std::to_string(::getpid()) + "-" + target.filename().string())).string();
+  try {
+    write(temp_path);
+  } catch (...) {
+    std::remove(temp_path.c_str());
+    throw;
+  }
+  std::error_code error;
+  std::filesystem::rename(temp_path, path, error);
+  if (error) {
+    std::remove(temp_path.c_str());
+    throw InputError(InputMessage(path, "", "cannot rename into place: " + error.message()));
+  }
+}
+
 }  // namespace omnical

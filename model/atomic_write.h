@@ -13,4 +13,10 @@ namespace omnical {
 // temporary file is removed on failure.
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+// The same for writers that open files themselves and pick the format from the name
+// (cv::FileStorage, cv::VideoWriter): write(temporary_path) gets a temporary path in the
+// target's directory that ends with the target's file name; it is renamed over path on
+// return and removed if write throws.
+void WriteFileAtomicallyByPath(const std::string& path, const std::function<void(const std::string&)>& write);
+
 }  // namespace omnical

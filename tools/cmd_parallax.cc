@@ -86,10 +86,11 @@ void RunForMaps(const Options& options, const Context& context) {
     result["error"].push_back({{"n", i < ns.size() ? nlohmann::json(ns[i]) : nlohmann::json("infinity")},
                                {"max_px", stats[i].max_px}, {"rms_px", stats[i].rms_px}});
   WriteOutput((dir / "maps-error.json").string(), [&](std::ostream& out) { out << result.dump(2) << '\n'; });
-  if (!context.quiet)
+  if (!context.quiet) {
+    const size_t at_n2 = std::find(ns.begin(), ns.end(), 2.0) - ns.begin();  // in the list by construction
     std::printf("%s: made for %s; at infinity max %.3f px, at n = 2 max %.3f px (output px) -> %s\n", options.maps_dir.c_str(),
-                made_for.c_str(), stats.back().max_px, RemapErrorAt(sensor, settings, ObjectAtDistance(settings.surface, 2 * rim), stride).max_px,
-                options.out_dir.c_str());
+                made_for.c_str(), stats.back().max_px, stats[at_n2].max_px, options.out_dir.c_str());
+  }
 }
 
 void Run(const Options& options, const Context& context) {

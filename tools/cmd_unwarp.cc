@@ -8,9 +8,9 @@
 #include <cctype>
 #include <filesystem>
 #include <optional>
-#include <unistd.h>
 
 #include "correction/map_export.h"
+#include "model/atomic_write.h"
 #include "model/input_error.h"
 #include "tools/commands.h"
 #include "tools/plot.h"
@@ -116,19 +116,16 @@ void Run(const Options& options, const Context& context) {
   double fps = capture.get(cv::CAP_PROP_FPS);
   if (!(fps > 0.0 && fps < 1000.0)) fps = 25.0;
   const long frames = std::max(1L, static_cast<long>(capture.get(cv::CAP_PROP_FRAME_COUNT)));
-  // Written under a temporary name with the same extension (the container is chosen by
-  // it), renamed when complete.
-  const std::filesystem::path target(options.out);
-  const std::filesystem::path temporary = target.parent_path() / (".tmp" + std::to_string(::getpid()) + "-" + target.filename().string());
+  // The container is chosen by the file name, which the temporary file keeps.
   long written = 0;
-  try {
+  WriteFileAtomicallyByPath(options.out, [&](const std::string& temporary) {
     cv::VideoWriter writer;
     Progress progress("unwarp", frames, context.quiet);
     cv::Mat frame;
     while (capture.read(frame)) {
       if (written == 0) {
         CheckFrameSize(frame, sensor_width, sensor_height, options.input);
-        if (!writer.open(temporary.string(), fourcc, fps, cv::Size(table.width, table.height), frame.channels() == 3))
+        if (!writer.open(temporary, fourcc, fps, cv::Size(table.width, table.height), frame.channels() == 3))
           throw InputError(InputMessage(options.out, "", "cannot be written as a video"));
       }
       writer.write(unwarp(frame));
@@ -137,12 +134,7 @@ void Run(const Options& options, const Context& context) {
     }
     writer.release();
     if (written == 0) throw InputError(InputMessage(options.input, "", "has no readable frames"));
-    std::filesystem::rename(temporary, target);
-  } catch (...) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    throw;
-  }
+  });
   if (!context.quiet) std::printf("%s -> %s: %ld frames (%dx%d)\n", options.input.c_str(), options.out.c_str(), written, table.width, table.height);
 }
 

@@ -1,0 +1,26 @@
+// Rows of an image-sized job handed out one at a time to a few threads (the calling thread
+// is one of them): rows cost different amounts (some see no mirror), so a shared counter
+// balances them better than fixed blocks.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <thread>
+#include <vector>
+
+namespace omnical {
+
+// Calls row(v) once for every v in [0, rows), from `threads` threads (at least one).
+template <typename RowFunction>
+void ParallelRows(int rows, int threads, const RowFunction& row) {
+  std::atomic<int> next{0};
+  auto work = [&]() {
+    for (int v = next++; v < rows; v = next++) row(v);
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& thread : pool) thread.join();
+}
+
+}  // namespace omnical
