@@ -15,6 +15,7 @@ namespace {
 
 constexpr double kMagnification = 2.0;     // patch px per omni px (at least, along both axes)
 constexpr double kMinNeighbourPx = 64.0;  // aprilgrid: 8 px border cells; checkerboard: a 25 px window
+constexpr double kFarMm = 1e8;  // "infinity": the rays' origins on the mirror (mm apart) do not matter
 
 // The corner ids next to `id` along the target's edges (aprilgrid: the two other corners
 // of its tag's black square; checkerboard: up to four grid neighbours).
@@ -84,21 +85,25 @@ bool EdgeCrossing(const cv::Mat& image, const Eigen::Vector2d& base, const Eigen
 // bisector). Instead each of the two edges is located along profiles across it, from 0.5
 // to 7 border cells from the corner (0.8 cell inside, 1.6 cells into the 2.4-cell gap),
 // fitted by a line, and the lines intersected; twice, the second time along the fitted
-// edges. Nearly the whole side averages the noise; its curvature in a magnified patch
-// through the guess is negligible.
+// edges. Nearly the whole side averages the noise. The edges must be straight where they
+// are fitted: in a patch through the guess they are, to the extent that the guess is right
+// and the patch sits at the board's depth (below).
 bool RefineSquareCorner(const cv::Mat& image, const Eigen::Vector2d& start, const Eigen::Vector2d (&towards)[2],
                         double cell_px, Eigen::Vector2d* refined) {
   if (cell_px < 1.5) return false;
   Eigen::Vector2d corner = start, edge[2] = {towards[0].normalized(), towards[1].normalized()};
-  // Ink level: the darker decile of the square's interior near the corner (its border
-  // cells and black data cells).
-  std::vector<double> interior;
-  for (double a = 0.3; a <= 3.0; a += 0.25)
-    for (double b = 0.3; b <= 3.0; b += 0.25)
-      if (const double v = Sample(image, start + cell_px * (a * edge[0] + b * edge[1])); std::isfinite(v)) interior.push_back(v);
-  if (interior.size() < 20) return false;
-  std::nth_element(interior.begin(), interior.begin() + interior.size() / 10, interior.end());
-  const double ink = interior[interior.size() / 10];
+  // Ink level: the median along the middle of the square's black border cells (half a cell
+  // in from both edges). Not a dark percentile of the whole interior: the bicubic patch
+  // undershoots next to every edge, the data cells' ones included, and a level pulled down
+  // that way put every edge ~0.02 px inside the square on renders (tags measured small).
+  std::vector<double> border;
+  for (int e = 0; e < 2; ++e)
+    for (double t = 1.0; t <= 7.0; t += 0.25)
+      if (const double v = Sample(image, start + cell_px * (t * edge[e] + 0.5 * edge[1 - e])); std::isfinite(v))
+        border.push_back(v);
+  if (border.size() < 20) return false;
+  std::nth_element(border.begin(), border.begin() + border.size() / 2, border.end());
+  const double ink = border[border.size() / 2];
   for (int pass = 0; pass < 2; ++pass) {
     Eigen::Vector2d point[2], direction[2];
     for (int e = 0; e < 2; ++e) {
@@ -177,6 +182,9 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
       if (guess->Unproject(pixel, &origin, &direction) == ProjectionStatus::kOk) rays[id] = {origin, direction};
     }
 
+  std::map<int, Eigen::Vector3d> board_mm;
+  for (const TargetCorner& c : target.corners()) board_mm[c.id] = c.point_in_target;
+
   ImageDetections out = detections;
   for (CornerObservation& corner : out.corners) {
     const std::vector<int> neighbour_ids = NeighboursOf(target, corner.id);
@@ -196,15 +204,29 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
       for (int axis = 0; axis < 2; ++axis) {
         Eigen::Vector2d offset_pixel;
         const double step_rad = 1e-3;
-        if (guess->Project(origin + 1e8 * (direction + step_rad * frame.col(axis)).normalized(), &offset_pixel) ==
+        if (guess->Project(origin + kFarMm * (direction + step_rad * frame.col(axis)).normalized(), &offset_pixel) ==
             ProjectionStatus::kOk)
           omni_px_per_rad = std::max(omni_px_per_rad, (offset_pixel - corner.pixel).norm() / step_rad);
       }
+      // The patch shows the sphere through the board's corner (its depth from the angle a
+      // known side subtends; tilt only shortens it, so the smallest estimate). At infinity
+      // instead, the board's edges bent by the missing single viewpoint and straight-edge
+      // fits missed corners by up to ~0.01 px, radius-dependent: on renders the mirror's
+      // size absorbed it (A 4 std off with the true sensor as the guess; 0.0 std here).
+      double depth_mm = HUGE_VAL;
+      for (int n : neighbour_ids)
+        if (rays.count(n) && board_mm.count(n) && board_mm.count(corner.id)) {
+          const double angle_rad = std::acos(std::clamp(direction.dot(rays[n].second), -1.0, 1.0));
+          if (angle_rad > 0.0) depth_mm = std::min(depth_mm, (board_mm[n] - board_mm[corner.id]).norm() / angle_rad);
+        }
+      if (!std::isfinite(depth_mm)) depth_mm = kFarMm;
+      // Neighbours as the patch sees them: their points at that depth, from this ray's
+      // origin (near the rim the rays' origins are mm apart).
       std::vector<Eigen::Vector2d> neighbours;  // in patch px from the patch centre, per unit focal length
       double distance = HUGE_VAL;
       for (int n : neighbour_ids)
         if (rays.count(n)) {
-          const Eigen::Vector3d v = frame.transpose() * rays[n].second;
+          const Eigen::Vector3d v = frame.transpose() * (rays[n].first + depth_mm * rays[n].second - origin);
           if (v.z() <= 0.0) continue;
           neighbours.emplace_back(v.x() / v.z(), v.y() / v.z());
           distance = std::min(distance, neighbours.back().norm());
@@ -217,7 +239,7 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
       // Bounded: a corner whose neighbours sit absurdly far is not refined.
       if (omni_px_per_rad > 0.0 && std::isfinite(distance) && distance < 2000.0) {
         const int half_size = static_cast<int>(std::ceil(ReachOf(target) * distance)) + 4;
-        const VirtualView patch(*guess, frame, origin, focal, 2 * half_size + 1, 2 * half_size + 1);
+        const VirtualView patch(*guess, frame, origin, focal, 2 * half_size + 1, 2 * half_size + 1, depth_mm);
         const cv::Mat image = patch.Resample(grey, cv::INTER_CUBIC);
         const Eigen::Vector2d centre(half_size, half_size);
         for (Eigen::Vector2d& n : neighbours) n += centre;
@@ -225,9 +247,18 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
         moved = RefineInImage(target, image, centre, neighbours, &refined_patch) && patch.ToOmni(refined_patch, &refined);
       }
     }
-    if (moved) corner.pixel = refined;
-    ++(moved ? local.refined : local.kept);
+    if (moved) {
+      corner.pixel = refined;
+      ++local.refined;
+    } else if (guess && target.type() == CalibrationTarget::Type::kAprilGrid) {
+      corner.id = -1;  // dropped below
+      ++local.dropped;
+    } else {
+      ++local.kept;
+    }
   }
+  out.corners.erase(std::remove_if(out.corners.begin(), out.corners.end(), [](const CornerObservation& c) { return c.id < 0; }),
+                    out.corners.end());
   if (stats) *stats = local;
   return out;
 }

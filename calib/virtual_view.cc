@@ -9,26 +9,21 @@
 
 namespace omnical {
 
-namespace {
-// Far enough that the rays' origins on the mirror (mm apart) do not matter (1e-8 rad).
-constexpr double kFarMm = 1e8;
-}  // namespace
-
 VirtualView::VirtualView(const Sensor& sensor, const Eigen::Matrix3d& view_to_camera,
-                         const Eigen::Vector3d& centre_in_camera_mm, double focal_px, int width_px, int height_px)
+                         const Eigen::Vector3d& centre_in_camera_mm, double focal_px, int width_px, int height_px, double depth_mm)
     : view_to_camera_(view_to_camera), focal_px_(focal_px) {
   const double cx = 0.5 * (width_px - 1), cy = 0.5 * (height_px - 1);
-  Eigen::Matrix3Xd far(3, static_cast<Eigen::Index>(width_px) * height_px);
+  Eigen::Matrix3Xd points(3, static_cast<Eigen::Index>(width_px) * height_px);
   for (int j = 0; j < height_px; ++j)
     for (int i = 0; i < width_px; ++i)
-      far.col(static_cast<Eigen::Index>(j) * width_px + i) =
-          centre_in_camera_mm + kFarMm * (view_to_camera * Eigen::Vector3d((i - cx) / focal_px, (j - cy) / focal_px, 1.0)).normalized();
+      points.col(static_cast<Eigen::Index>(j) * width_px + i) =
+          centre_in_camera_mm + depth_mm * (view_to_camera * Eigen::Vector3d((i - cx) / focal_px, (j - cy) / focal_px, 1.0)).normalized();
   Eigen::Matrix2Xd pixels;
   std::vector<ProjectionStatus> statuses;
-  sensor.ProjectBatch(far, &pixels, &statuses);
+  sensor.ProjectBatch(points, &pixels, &statuses);
   map_x_.create(height_px, width_px, CV_32F);
   map_y_.create(height_px, width_px, CV_32F);
-  for (Eigen::Index k = 0; k < far.cols(); ++k) {
+  for (Eigen::Index k = 0; k < points.cols(); ++k) {
     const bool ok = statuses[k] == ProjectionStatus::kOk;
     map_x_.at<float>(static_cast<int>(k / width_px), static_cast<int>(k % width_px)) = ok ? static_cast<float>(pixels(0, k)) : -1.0f;
     map_y_.at<float>(static_cast<int>(k / width_px), static_cast<int>(k % width_px)) = ok ? static_cast<float>(pixels(1, k)) : -1.0f;

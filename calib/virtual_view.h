@@ -1,6 +1,7 @@
 // A virtual perspective view resampled from the omni image: a pinhole camera at a point
 // of the sensor (its reference viewpoint, or a ray's own origin) looking along a chosen
-// frame. Each view pixel holds the exact projection of a far point along its ray, so
+// frame. Each view pixel holds the exact projection of the point along its ray at the
+// view's depth, so
 // anything found in the view maps back to omni pixels through the same table, whatever
 // the error of the sensor the view was built with.
 #pragma once
@@ -15,8 +16,11 @@ namespace omnical {
 class VirtualView {
  public:
   // view_to_camera: columns right, down, forward of the view in the camera frame.
+  // The view shows the sphere of radius depth_mm around its centre: the mirror has no
+  // single viewpoint, so a scene at another distance is slightly bent in it (straight
+  // lines curve). The default (1e8 mm) is the scene at infinity.
   VirtualView(const Sensor& sensor, const Eigen::Matrix3d& view_to_camera, const Eigen::Vector3d& centre_in_camera_mm,
-              double focal_px, int width_px, int height_px);
+              double focal_px, int width_px, int height_px, double depth_mm = 1e8);
 
   // The view of the omni image (8-bit grey), 0 where a ray misses the mirror.
   cv::Mat Resample(const cv::Mat& omni_grey, int interpolation) const;

@@ -35,6 +35,7 @@ struct Options {
   double loss_px = 1.0;
   int max_iterations = 200;
   bool leave_one_out = false;
+  int detection_passes = 2;
 };
 
 std::set<std::string> SplitList(const std::string& text) {
@@ -104,6 +105,64 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
   WritePng((dir / "per_view_rms.png").string(), RenderPanel(per_view, 800, 500));
 }
 
+// Drops corner ids the target does not have; throws if none is left.
+void ForgetUnknownIds(const CalibrationTarget& target, const std::string& target_path, const std::string& source,
+                      DetectionSet* detections) {
+  std::set<int> ids;
+  for (const TargetCorner& c : target.corners()) ids.insert(c.id);
+  int matched = 0;
+  for (ImageDetections& image : detections->images) {
+    image.corners.erase(std::remove_if(image.corners.begin(), image.corners.end(),
+                                       [&](const CornerObservation& c) { return !ids.count(c.id); }),
+                        image.corners.end());
+    matched += static_cast<int>(image.corners.size());
+  }
+  if (matched == 0) throw InputError(InputMessage(target_path, "", "the target spec matches no corner id in " + source));
+}
+
+struct UsableViews {
+  DetectionSet detections;  // the views with a starting pose
+  std::vector<TargetPose> poses;
+  int observations = 0;  // corners
+};
+
+// Views with at least 4 corners and a pose through `start`; throws when they cannot
+// determine the sensor.
+UsableViews ViewsForFit(const Sensor& start, const CalibrationTarget& target, const DetectionSet& detections,
+                        const std::string& source, bool quiet) {
+  UsableViews views;
+  views.detections = detections;
+  views.detections.images.clear();
+  for (const ImageDetections& image : detections.images) {
+    TargetPose pose;
+    if (image.corners.size() < 4 || !InitialTargetPose(start, target, image, &pose)) {
+      if (!quiet) std::fprintf(stderr, "omnical: warning: %s: too few usable corners, view skipped\n", image.image.c_str());
+      continue;
+    }
+    views.detections.images.push_back(image);
+    views.poses.push_back(pose);
+  }
+  // Enough data for what is asked: 2 residuals per corner against 6 per view plus the
+  // sensor's free parameters, and views that differ (one pose says nothing about the
+  // mirror).
+  for (const ImageDetections& image : views.detections.images) views.observations += static_cast<int>(image.corners.size());
+  const int sensor_parameters = static_cast<int>(SensorParameters(start).size());
+  const int view_count = static_cast<int>(views.detections.images.size());
+  if (view_count < 3 || 2 * views.observations < 2 * (6 * view_count + sensor_parameters))
+    throw InputError(InputMessage(source, "images",
+                                  std::to_string(view_count) + " usable views with " + std::to_string(views.observations) +
+                                      " corners are too few for the " + std::to_string(sensor_parameters) +
+                                      " sensor parameters (need >= 3 views)"));
+  double spread_deg = 0.0, spread_mm = 0.0;
+  for (const TargetPose& pose : views.poses) {
+    spread_deg = std::max(spread_deg, pose.camera_from_target_rotation.angularDistance(views.poses[0].camera_from_target_rotation) * 180.0 / M_PI);
+    spread_mm = std::max(spread_mm, (pose.camera_from_target_translation_mm - views.poses[0].camera_from_target_translation_mm).norm());
+  }
+  if (spread_deg < 1.0 && spread_mm < 5.0)
+    throw InputError(InputMessage(source, "images", "all views show the target at one pose: move it between images"));
+  return views;
+}
+
 // The rim circle of the images a detections file names (the median over those that read).
 std::optional<RimCircle> RimOfImages(const DetectionSet& detections) {
   std::vector<RimCircle> circles;
@@ -168,50 +227,33 @@ void Run(const Options& options, const Context& context) {
   fit_options.max_iterations = options.max_iterations;
   if (const std::string why = fit_options.Check(); !why.empty()) throw InputError(why);
 
-  // Views: known ids only, at least 4 corners, and a pose through the guess.
-  std::set<int> ids;
-  for (const TargetCorner& c : target.corners()) ids.insert(c.id);
-  int matched = 0;
-  for (ImageDetections& image : detections.images) {
-    image.corners.erase(std::remove_if(image.corners.begin(), image.corners.end(),
-                                       [&](const CornerObservation& c) { return !ids.count(c.id); }),
-                        image.corners.end());
-    matched += static_cast<int>(image.corners.size());
-  }
-  if (matched == 0)
-    throw InputError(InputMessage(options.target_path, "", "the target spec matches no corner id in " + source));
-  DetectionSet usable = detections;
-  usable.images.clear();
-  std::vector<TargetPose> poses;
-  for (const ImageDetections& image : detections.images) {
-    TargetPose pose;
-    if (image.corners.size() < 4 || !InitialTargetPose(guess, target, image, &pose)) {
-      if (!context.quiet) std::fprintf(stderr, "omnical: warning: %s: too few usable corners, view skipped\n", image.image.c_str());
-      continue;
+  ForgetUnknownIds(target, options.target_path, source, &detections);
+  UsableViews views = ViewsForFit(guess, target, detections, source, context.quiet);
+  const Sensor* fit_start = &guess;  // where the final fit started
+  std::optional<Sensor> refit_start;
+  FitResult fit = FitSensor(guess, target, views.detections, views.poses, fit_options);
+  // Second detection pass (aprilgrid from images): the corners are refined in patches
+  // through a sensor, and a tag's straight edges are straight there only as far as that
+  // sensor is right. Through the design guess the patch edges bend, and the corners
+  // carried a radius-dependent bias the mirror's size absorbed (renders: A 10 std off);
+  // re-detected through the first fit they do not (tests/cli/calibrate_render_test.sh).
+  if (fit.sensor && !options.images.empty() && target.type() == CalibrationTarget::Type::kAprilGrid)
+    for (int pass = 2; pass <= options.detection_passes && fit.sensor; ++pass) {
+      refit_start = *fit.sensor;
+      const Sensor& first = *refit_start;
+      ImageDetectionOptions detection;
+      detection.guess = &first;
+      detection.threads = options.threads;
+      detection.quiet = context.quiet;
+      detections = DetectImages(target, options.target_path, options.images, detection).detections;
+      ForgetUnknownIds(target, options.target_path, source, &detections);
+      views = ViewsForFit(first, target, detections, source, context.quiet);
+      fit_start = &first;
+      fit = FitSensor(first, target, views.detections, views.poses, fit_options);
     }
-    usable.images.push_back(image);
-    poses.push_back(pose);
-  }
-  // Enough data for what is asked: 2 residuals per corner against 6 per view plus the
-  // sensor's free parameters, and views that differ (one pose says nothing about the
-  // mirror).
-  int observations = 0;
-  for (const ImageDetections& image : usable.images) observations += static_cast<int>(image.corners.size());
-  const int sensor_parameters = static_cast<int>(SensorParameters(guess).size());
-  if (usable.images.size() < 3 || 2 * observations < 2 * (6 * static_cast<int>(usable.images.size()) + sensor_parameters))
-    throw InputError(InputMessage(source, "images",
-                                  std::to_string(usable.images.size()) + " usable views with " + std::to_string(observations) +
-                                      " corners are too few for the " + std::to_string(sensor_parameters) +
-                                      " sensor parameters (need >= 3 views)"));
-  double spread_deg = 0.0, spread_mm = 0.0;
-  for (const TargetPose& pose : poses) {
-    spread_deg = std::max(spread_deg, pose.camera_from_target_rotation.angularDistance(poses[0].camera_from_target_rotation) * 180.0 / M_PI);
-    spread_mm = std::max(spread_mm, (pose.camera_from_target_translation_mm - poses[0].camera_from_target_translation_mm).norm());
-  }
-  if (spread_deg < 1.0 && spread_mm < 5.0)
-    throw InputError(InputMessage(source, "images", "all views show the target at one pose: move it between images"));
-
-  const FitResult fit = FitSensor(guess, target, usable, poses, fit_options);
+  const DetectionSet& usable = views.detections;
+  const std::vector<TargetPose>& poses = views.poses;
+  const int observations = views.observations;
   if (!fit.sensor) throw InputError(InputMessage(source, "", "the fit failed: " + fit.solver_report));
   const std::string why_invalid = ValidateSensorModel(fit.sensor->model());
 
@@ -226,6 +268,7 @@ void Run(const Options& options, const Context& context) {
   result["robust_loss_px"] = fit_options.robust_loss_px;
   result["covariance_ok"] = fit.covariance_ok;
   result["start"] = start;
+  result["detection_passes"] = fit_start == &guess ? 1 : options.detection_passes;
   if (rim)
     result["rim_circle"] = {{"centre_px", {rim->centre_px.x(), rim->centre_px.y()}},
                             {"radius_px", rim->radius_px},
@@ -241,7 +284,7 @@ void Run(const Options& options, const Context& context) {
       std::vector<TargetPose> subset_poses = poses;
       subset.images.erase(subset.images.begin() + left_out);
       subset_poses.erase(subset_poses.begin() + left_out);
-      const FitResult fold = FitSensor(guess, target, subset, subset_poses, quick);
+      const FitResult fold = FitSensor(*fit_start, target, subset, subset_poses, quick);
       for (const ParameterEstimate& p : fold.parameters) folds[p.name].push_back(p.value);
       if (!context.quiet) std::fprintf(stderr, "\rleave-one-out: %zu/%zu", left_out + 1, usable.images.size());
     }
@@ -338,6 +381,10 @@ Command CalibrateCommand() {
                 ->check(CLI::Range(0.0, 1000.0))->capture_default_str();
             sub.add_option("--max-iterations", options->max_iterations, "Solver iterations per stage")
                 ->check(CLI::Range(1, 100000))->capture_default_str();
+            sub.add_option("--detection-passes", options->detection_passes,
+                           "With --images and an aprilgrid: pass 2 re-detects the corners through the first fit's "
+                           "sensor and fits again (1: a single pass)")
+                ->check(CLI::Range(1, 5))->capture_default_str();
             sub.add_flag("--leave-one-out", options->leave_one_out,
                          "Also fit without each image in turn; calibration.json gets each parameter's spread");
             return [options, &context]() { Run(*options, context); };

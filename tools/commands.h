@@ -17,10 +17,12 @@ Command DetectCommand();
 Command CalibrateCommand();
 Command RemapCommand();
 Command UnwarpCommand();
+Command ExportCentralCommand();
 
 inline std::vector<Command> AllCommands() {
   return {ProjectCommand(), UnprojectCommand(), CharacterizeCommand(), ParallaxCommand(), TargetCommand(),
-          RenderCommand(),  DetectCommand(),    CalibrateCommand(), RemapCommand(),    UnwarpCommand()};
+          RenderCommand(),  DetectCommand(),    CalibrateCommand(), RemapCommand(),    UnwarpCommand(),
+          ExportCentralCommand()};
 }
 
 }  // namespace omnical::cli
