@@ -173,9 +173,8 @@ bool MeiModel::Project(const Eigen::Vector3d& point_in_mirror, Eigen::Vector2d* 
   return true;
 }
 
-MeiModel FitMei(const Sensor& sensor, const CentralFitSamples& samples, double v0_mm) {
+MeiModel FitMei(const CentralFitSamples& samples, double v0_mm) {
   RequireSamples(samples);
-  (void)sensor;
   const Eigen::Vector3d v0(0.0, 0.0, v0_mm);
   // Start: xi = 1 (a paraboloid's model), the field's mean pixel as the centre, the focal
   // length from the median ratio of image radius to the model's normalised radius.
@@ -228,7 +227,7 @@ OCamModel FitOCam(const Sensor& sensor, const CentralFitSamples& samples, double
   const Eigen::Vector3d v0(0.0, 0.0, v0_mm);
   // Start from the Mei fit's centre and local scale (the weight that turns a direction
   // error into px).
-  const MeiModel mei = FitMei(sensor, samples, v0_mm);
+  const MeiModel mei = FitMei(samples, v0_mm);
   const double start_centre[5] = {mei.cy, mei.cx, 1.0, 0.0, 0.0};
   std::vector<double> px_per_rad(samples.pixels.size());
   double rho_scale = 0.0;

@@ -63,7 +63,7 @@ struct OCamModel {
 };
 
 // Fits; throws std::runtime_error if the samples are too few.
-MeiModel FitMei(const Sensor& sensor, const CentralFitSamples& samples, double v0_mm);
+MeiModel FitMei(const CentralFitSamples& samples, double v0_mm);
 OCamModel FitOCam(const Sensor& sensor, const CentralFitSamples& samples, double v0_mm);
 
 template <typename Model>

@@ -31,6 +31,8 @@ mkdir -p "$out"
   --input "$out/render/near-front.png" \
   --out "$out/calibration/remap-n7/near-front-panorama.png"
 "$omnical" parallax --maps "$out/calibration/remap-n7" --out "$out/calibration/remap-n7/error"
+# The best-fit central (Mei) model for central-only tools, with its error over the field.
+"$omnical" export-central --sensor "$out/calibration/sensor.yaml" --model mei --n 7 --out "$out/calibration/central-mei"
 
 for mirror in ohte-sph ohte-edi ohte-svp; do
   sensor="$omnical_root/datasets-synthetic/sensors/$mirror.yaml"

@@ -48,7 +48,7 @@ TEST(CentralFit, SingleViewpointMirrorIsFittedExactly) {
   const Sensor sensor = LoadSensorYaml(SensorPath("ohte-svp"));
   const CentralFitSamples samples = SampleField(sensor, ObjectSurface{}, 0.0, 24.0);
   ASSERT_GT(samples.pixels.size(), 500u);
-  const MeiModel mei = FitMei(sensor, samples, 0.0);
+  const MeiModel mei = FitMei(samples, 0.0);
   EXPECT_LT(ErrorOf(mei, samples).max_px, 1e-4);
   const OCamModel ocam = FitOCam(sensor, samples, 0.0);
   EXPECT_LT(ErrorOf(ocam, samples).max_px, 0.01);
@@ -61,7 +61,7 @@ TEST(CentralFit, SphereFitIsAnApproximationWithAReportedError) {
   const Sensor sensor = LoadSensorYaml(SensorPath("ohte-sph"));
   const double n7 = 7.0 * sensor.rim_radius_mm();
   const CentralFitSamples samples = SampleField(sensor, SphereAt(n7), 0.0, 24.0);
-  const ApproximationError error = ErrorOf(FitMei(sensor, samples, 0.0), samples);
+  const ApproximationError error = ErrorOf(FitMei(samples, 0.0), samples);
   EXPECT_GT(error.rms_px, 0.01);
   EXPECT_LT(error.max_px, 5.0);
 }

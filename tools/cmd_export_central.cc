@@ -109,7 +109,7 @@ void Run(const Options& options, const Context& context) {
   OCamModel ocam;
   ApproximationError error;
   if (options.model == "mei") {
-    mei = FitMei(sensor, samples, v0_mm);
+    mei = FitMei(samples, v0_mm);
     error = ErrorOf(mei, samples);
   } else {
     ocam = FitOCam(sensor, samples, v0_mm);
