@@ -13,7 +13,7 @@
 // it keep the detector's position.
 //
 // Measured (tests/bench/detection_recall, docs/detection-recall.md): aprilgrid corners
-// 0.079-0.127 px RMS from virtual views -> 0.054-0.089 px refined in patches; raw
+// 0.079-0.127 px RMS from virtual views -> 0.045-0.092 px refined in patches; raw
 // 0.19-0.40 -> 0.11-0.35 refined on the omni image. Checkerboards on renders 0.189 ->
 // 0.068 px, but on the real Mei images the fit's RMS grows (0.376 -> 0.402 px, no outlier
 // cut): OpenCV's findChessboardCornersSB corners are kept unless asked
