@@ -15,7 +15,6 @@ namespace {
 
 constexpr double kMagnification = 2.0;     // patch px per omni px (at least, along both axes)
 constexpr double kMinNeighbourPx = 64.0;  // aprilgrid: 8 px border cells; checkerboard: a 25 px window
-constexpr double kFarMm = 1e8;  // "infinity": the rays' origins on the mirror (mm apart) do not matter
 
 // The corner ids next to `id` along the target's edges (aprilgrid: the two other corners
 // of its tag's black square; checkerboard: up to four grid neighbours).
@@ -186,7 +185,8 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
   for (const TargetCorner& c : target.corners()) board_mm[c.id] = c.point_in_target;
 
   ImageDetections out = detections;
-  for (CornerObservation& corner : out.corners) {
+  out.corners.clear();
+  for (CornerObservation corner : detections.corners) {
     const std::vector<int> neighbour_ids = NeighboursOf(target, corner.id);
     bool moved = false;
     Eigen::Vector2d refined;
@@ -204,7 +204,7 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
       for (int axis = 0; axis < 2; ++axis) {
         Eigen::Vector2d offset_pixel;
         const double step_rad = 1e-3;
-        if (guess->Project(origin + kFarMm * (direction + step_rad * frame.col(axis)).normalized(), &offset_pixel) ==
+        if (guess->Project(origin + VirtualView::kFarMm * (direction + step_rad * frame.col(axis)).normalized(), &offset_pixel) ==
             ProjectionStatus::kOk)
           omni_px_per_rad = std::max(omni_px_per_rad, (offset_pixel - corner.pixel).norm() / step_rad);
       }
@@ -219,7 +219,7 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
           const double angle_rad = std::acos(std::clamp(direction.dot(rays[n].second), -1.0, 1.0));
           if (angle_rad > 0.0) depth_mm = std::min(depth_mm, (board_mm[n] - board_mm[corner.id]).norm() / angle_rad);
         }
-      if (!std::isfinite(depth_mm)) depth_mm = kFarMm;
+      if (!std::isfinite(depth_mm)) depth_mm = VirtualView::kFarMm;
       // Neighbours as the patch sees them: their points at that depth, from this ray's
       // origin (near the rim the rays' origins are mm apart).
       std::vector<Eigen::Vector2d> neighbours;  // in patch px from the patch centre, per unit focal length
@@ -251,14 +251,13 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
       corner.pixel = refined;
       ++local.refined;
     } else if (guess && target.type() == CalibrationTarget::Type::kAprilGrid) {
-      corner.id = -1;  // dropped below
       ++local.dropped;
+      continue;
     } else {
       ++local.kept;
     }
+    out.corners.push_back(corner);
   }
-  out.corners.erase(std::remove_if(out.corners.begin(), out.corners.end(), [](const CornerObservation& c) { return c.id < 0; }),
-                    out.corners.end());
   if (stats) *stats = local;
   return out;
 }

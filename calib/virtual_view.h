@@ -16,11 +16,14 @@ namespace omnical {
 class VirtualView {
  public:
   // view_to_camera: columns right, down, forward of the view in the camera frame.
+  // "Infinity": far enough that the rays' origins on the mirror (mm apart) do not matter.
+  static constexpr double kFarMm = 1e8;
+
   // The view shows the sphere of radius depth_mm around its centre: the mirror has no
   // single viewpoint, so a scene at another distance is slightly bent in it (straight
-  // lines curve). The default (1e8 mm) is the scene at infinity.
+  // lines curve). The default is the scene at infinity.
   VirtualView(const Sensor& sensor, const Eigen::Matrix3d& view_to_camera, const Eigen::Vector3d& centre_in_camera_mm,
-              double focal_px, int width_px, int height_px, double depth_mm = 1e8);
+              double focal_px, int width_px, int height_px, double depth_mm = kFarMm);
 
   // The view of the omni image (8-bit grey), 0 where a ray misses the mirror.
   cv::Mat Resample(const cv::Mat& omni_grey, int interpolation) const;

@@ -229,8 +229,7 @@ void Run(const Options& options, const Context& context) {
 
   ForgetUnknownIds(target, options.target_path, source, &detections);
   UsableViews views = ViewsForFit(guess, target, detections, source, context.quiet);
-  const Sensor* fit_start = &guess;  // where the final fit started
-  std::optional<Sensor> refit_start;
+  std::optional<Sensor> refit_start;  // the previous pass's fit, where the last fit started
   FitResult fit = FitSensor(guess, target, views.detections, views.poses, fit_options);
   // Second detection pass (aprilgrid from images): the corners are refined in patches
   // through a sensor, and a tag's straight edges are straight there only as far as that
@@ -238,20 +237,19 @@ void Run(const Options& options, const Context& context) {
   // carried a radius-dependent bias the mirror's size absorbed; re-detected through the
   // first fit they do not (30-view render: A 6 std off after one pass, 0.5 std after two;
   // tests/cli/calibrate_render_test.sh).
-  if (fit.sensor && !options.images.empty() && target.type() == CalibrationTarget::Type::kAprilGrid)
-    for (int pass = 2; pass <= options.detection_passes && fit.sensor; ++pass) {
-      refit_start = *fit.sensor;
-      const Sensor& first = *refit_start;
-      ImageDetectionOptions detection;
-      detection.guess = &first;
-      detection.threads = options.threads;
-      detection.quiet = context.quiet;
-      detections = DetectImages(target, options.target_path, options.images, detection).detections;
-      ForgetUnknownIds(target, options.target_path, source, &detections);
-      views = ViewsForFit(first, target, detections, source, context.quiet);
-      fit_start = &first;
-      fit = FitSensor(first, target, views.detections, views.poses, fit_options);
-    }
+  const bool redetect = !options.images.empty() && target.type() == CalibrationTarget::Type::kAprilGrid;
+  for (int pass = 2; redetect && pass <= options.detection_passes && fit.sensor; ++pass) {
+    refit_start = *fit.sensor;
+    ImageDetectionOptions detection;
+    detection.guess = &*refit_start;
+    detection.threads = options.threads;
+    detection.quiet = context.quiet;
+    detections = DetectImages(target, options.target_path, options.images, detection).detections;
+    ForgetUnknownIds(target, options.target_path, source, &detections);
+    views = ViewsForFit(*refit_start, target, detections, source, context.quiet);
+    fit = FitSensor(*refit_start, target, views.detections, views.poses, fit_options);
+  }
+  const Sensor& fit_start = refit_start ? *refit_start : guess;
   const DetectionSet& usable = views.detections;
   const std::vector<TargetPose>& poses = views.poses;
   const int observations = views.observations;
@@ -269,7 +267,7 @@ void Run(const Options& options, const Context& context) {
   result["robust_loss_px"] = fit_options.robust_loss_px;
   result["covariance_ok"] = fit.covariance_ok;
   result["start"] = start;
-  result["detection_passes"] = fit_start == &guess ? 1 : options.detection_passes;
+  result["detection_passes"] = refit_start ? options.detection_passes : 1;
   if (rim)
     result["rim_circle"] = {{"centre_px", {rim->centre_px.x(), rim->centre_px.y()}},
                             {"radius_px", rim->radius_px},
@@ -285,7 +283,7 @@ void Run(const Options& options, const Context& context) {
       std::vector<TargetPose> subset_poses = poses;
       subset.images.erase(subset.images.begin() + left_out);
       subset_poses.erase(subset_poses.begin() + left_out);
-      const FitResult fold = FitSensor(*fit_start, target, subset, subset_poses, quick);
+      const FitResult fold = FitSensor(fit_start, target, subset, subset_poses, quick);
       for (const ParameterEstimate& p : fold.parameters) folds[p.name].push_back(p.value);
       if (!context.quiet) std::fprintf(stderr, "\rleave-one-out: %zu/%zu", left_out + 1, usable.images.size());
     }

@@ -14,13 +14,13 @@
 #include <ostream>
 
 #include "correction/central_fit.h"
-#include "correction/viewpoint_error.h"
 #include "model/atomic_write.h"
 #include "model/input_error.h"
 #include "model/optics.h"
 #include "tools/commands.h"
 #include "tools/plot.h"
 #include "tools/progress.h"
+#include "tools/view_setup.h"
 
 namespace omnical::cli {
 namespace {
@@ -86,14 +86,8 @@ void Run(const Options& options, const Context& context) {
   }
   if (!(options.step_px >= 1.0)) throw InputError("--step-px: must be >= 1");
   const bool at_infinity = surface.kind == ObjectSurface::Kind::kInfinity;
-  const double reference_mm = at_infinity ? 1e4 * rim : surface.distance_mm;
-  double v0_mm;
-  if (options.v0_mm) {
-    if (!std::isfinite(*options.v0_mm)) throw InputError("--v0: not finite");
-    v0_mm = *options.v0_mm;
-  } else {
-    v0_mm = BestViewpointMm(AnalyzeField(sensor, 360, reference_mm), reference_mm);
-  }
+  const double reference_mm = ReferenceDistanceMm(sensor, surface);
+  const double v0_mm = ResolveV0Mm(AnalyzeField(sensor, 360, reference_mm), reference_mm, options.v0_mm);
   const std::string distance_text =
       at_infinity ? "objects at infinity" : "objects on a sphere of " + std::to_string(surface.distance_mm) + " mm around V0";
 
@@ -107,19 +101,15 @@ void Run(const Options& options, const Context& context) {
                      " pixels see the mirror at --step-px " + std::to_string(options.step_px) + ": nothing to fit");
   MeiModel mei;
   OCamModel ocam;
-  ApproximationError error;
   if (options.model == "mei") {
     mei = FitMei(samples, v0_mm);
-    error = ErrorOf(mei, samples);
   } else {
     ocam = FitOCam(sensor, samples, v0_mm);
-    error = ErrorOf(ocam, samples);
   }
+  auto error_of = [&](const CentralFitSamples& s) { return options.model == "mei" ? ErrorOf(mei, s) : ErrorOf(ocam, s); };
+  const ApproximationError error = error_of(samples);
   progress.Advance();
-  auto error_at = [&](const ObjectSurface& other) {
-    const CentralFitSamples s = SampleField(sensor, other, v0_mm, 2.0 * options.step_px);
-    return options.model == "mei" ? ErrorOf(mei, s) : ErrorOf(ocam, s);
-  };
+  auto error_at = [&](const ObjectSurface& other) { return error_of(SampleField(sensor, other, v0_mm, 2.0 * options.step_px)); };
   nlohmann::json elsewhere = nlohmann::json::array();
   for (double n : ns) {
     ObjectSurface other;

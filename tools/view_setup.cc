@@ -110,20 +110,13 @@ ResolvedView ResolveView(const Sensor& sensor, const ViewOptions& options) {
   if (const std::string problem = surface.Check(); !problem.empty()) throw InputError("--" + problem);
 
   // The field (aligned counterpart for a misaligned sensor): the default ranges and V0.
-  const double reference_distance = surface.kind == ObjectSurface::Kind::kInfinity ? 1e4 * rim : surface.distance_mm;
+  const double reference_distance = ReferenceDistanceMm(sensor, surface);
   const std::vector<FieldSample> field = AnalyzeField(sensor, 360, reference_distance);
   double omega_min = HUGE_VAL, omega_max = 0.0;
   for (const FieldSample& f : field) omega_min = std::min(omega_min, f.ray.omega_rad), omega_max = std::max(omega_max, f.ray.omega_rad);
   omega_min /= kDeg, omega_max /= kDeg;
-  if (options.v0_mm) {
-    if (!std::isfinite(*options.v0_mm)) throw InputError(OptionError("--v0", "not finite"));
-    settings.v0_mm = *options.v0_mm;
-  } else {
-    // For an infinity table V0 only matters for how wrong it is at finite distances:
-    // the best V0 for far objects (its limit).
-    settings.v0_mm = BestViewpointMm(field, reference_distance);
-    resolved.v0_searched = true;
-  }
+  settings.v0_mm = ResolveV0Mm(field, reference_distance, options.v0_mm);
+  resolved.v0_searched = !options.v0_mm;
 
   screen.azimuth0_deg = options.azimuth0_deg;
   if (options.elevation_deg.size() == 2) {
@@ -139,6 +132,16 @@ ResolvedView ResolveView(const Sensor& sensor, const ViewOptions& options) {
   if (const std::string problem = screen.Check(); !problem.empty()) throw InputError("--" + problem);
   settings.threads = options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   return resolved;
+}
+
+double ReferenceDistanceMm(const Sensor& sensor, const ObjectSurface& surface) {
+  return surface.kind == ObjectSurface::Kind::kInfinity ? 1e4 * sensor.rim_radius_mm() : surface.distance_mm;
+}
+
+double ResolveV0Mm(const std::vector<FieldSample>& field, double reference_distance_mm, const std::optional<double>& given) {
+  if (!given) return BestViewpointMm(field, reference_distance_mm);
+  if (!std::isfinite(*given)) throw InputError(OptionError("--v0", "not finite"));
+  return *given;
 }
 
 nlohmann::json ScreenJson(const VirtualScreen& s) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "correction/remap_table.h"
+#include "model/optics.h"
 
 namespace omnical::cli {
 
@@ -42,6 +43,13 @@ struct ResolvedView {
 // V0 that minimises the worst error at the distance) and checks everything; throws
 // InputError "option: problem".
 ResolvedView ResolveView(const Sensor& sensor, const ViewOptions& options);
+
+// The distance V0 is chosen for: the surface's, or 1e4 rim radii for infinity (the limit
+// of the best V0 for far objects; V0 only matters there for finite distances).
+double ReferenceDistanceMm(const Sensor& sensor, const ObjectSurface& surface);
+// V0 (z on the mirror axis, mm): `given` if set (InputError on --v0 if not finite), else
+// the one minimising the worst error over `field` at `reference_distance_mm`.
+double ResolveV0Mm(const std::vector<FieldSample>& field, double reference_distance_mm, const std::optional<double>& given);
 
 // maps.json pieces. The view entry holds the geometry completely, with the formula from
 // output pixel to viewing direction.

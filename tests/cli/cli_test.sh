@@ -6,13 +6,7 @@ set -u
 omnical=$1
 source_dir=$(cd "$2" && pwd)
 sensors=$source_dir/datasets-synthetic/sensors
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-passed=0
-failed=0
-
-pass() { passed=$((passed + 1)); }
-fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
+source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
 
 # expect_error NAME EXPECTED_SUBSTRING -- ARGS...: exit code 2, one stderr line containing
 # the substring, and no file at $work/out.csv afterwards.
@@ -291,5 +285,4 @@ mkdir -p "$work/mixed" && cp "$rendered/near-front.png" "$rendered/near000.png" 
   [ "$(python3 -c "import json,sys; print(len(json.load(open(sys.argv[1]))['images']))" "$work/mixed.json")" = 2 ] && pass ||
   fail "detect with a corrupt image"
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+summary cli_test

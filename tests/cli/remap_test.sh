@@ -10,13 +10,7 @@ mapcheck=$3
 sensors=$source_dir/datasets-synthetic/sensors
 omni=$source_dir/datasets-synthetic/rendered/ohte-sph-misaligned-near/near-front.png  # 1040 x 1040
 omni_aligned=$source_dir/datasets-synthetic/rendered/ohte-sph-near/near-front.png  # 1000 x 1000
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-passed=0
-failed=0
-pass() { passed=$((passed + 1)); }
-fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
-check() { if "$@"; then pass; else fail "$*"; fi; }
+source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
 
 # expect_error NAME EXPECTED_SUBSTRING OUT -- ARGS...: exit 2, one stderr line with the
 # substring, nothing at OUT afterwards.
@@ -124,5 +118,4 @@ printf 'not an image' >"$work/corrupt.png"
 expect_error "corrupt image" "corrupt.png" "$work/bad" -- \
   unwarp --maps "$maps" --input "$work/corrupt.png" --out "$work/bad/x.png"
 
-echo "remap_test: $passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+summary remap_test
