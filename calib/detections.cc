@@ -42,6 +42,7 @@ DetectionSet ReadDetections(const std::string& path) {
         CornerObservation c;
         c.id = corner.at("id").get<int>();
         c.pixel = Eigen::Vector2d(corner.at("pixel").at(0).get<double>(), corner.at("pixel").at(1).get<double>());
+        c.unrefined = corner.contains("refined") && !corner.at("refined").get<bool>();
         const std::string where = "images[" + std::to_string(i) + "] (" + image.image + ")";
         if (!std::isfinite(c.pixel.x()) || !std::isfinite(c.pixel.y()))
           throw InputError(InputMessage(path, where, "corner " + std::to_string(c.id) + " has a non-finite pixel"));
@@ -66,7 +67,11 @@ void WriteDetections(const DetectionSet& detections, const std::string& path) {
     nlohmann::json entry;
     entry["image"] = image.image;
     entry["corners"] = nlohmann::json::array();
-    for (const CornerObservation& c : image.corners) entry["corners"].push_back({{"id", c.id}, {"pixel", {c.pixel.x(), c.pixel.y()}}});
+    for (const CornerObservation& c : image.corners) {
+      nlohmann::json corner = {{"id", c.id}, {"pixel", {c.pixel.x(), c.pixel.y()}}};
+      if (c.unrefined) corner["refined"] = false;
+      entry["corners"].push_back(corner);
+    }
     json["images"].push_back(entry);
   }
   WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(1) << '\n'; });

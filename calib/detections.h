@@ -11,6 +11,10 @@ namespace omnical {
 struct CornerObservation {
   int id;                 // the target's corner id (calib/target.h)
   Eigen::Vector2d pixel;  // u = column, v = row; pixel (0, 0) has its centre at (0, 0)
+  // Sub-pixel refinement through a sensor guess failed (occluded edge, cut by the rim, a
+  // neighbour missing): the detector's own position, 0.1-9 px off on renders instead of
+  // ~0.05. Kept so the detection is not lost; `omnical calibrate` leaves it out of the fit.
+  bool unrefined = false;
 };
 
 struct ImageDetections {
@@ -25,7 +29,8 @@ struct DetectionSet {
 };
 
 // JSON: {"target": spec, "image_size": [W, H], "images": [{"image": path,
-// "corners": [{"id": i, "pixel": [u, v]}, ...]}, ...]}. Read throws InputError naming the
+// "corners": [{"id": i, "pixel": [u, v]}, ...]}, ...]}; an unrefined corner also has
+// "refined": false. Read throws InputError naming the
 // file and the entry; write is atomic.
 DetectionSet ReadDetections(const std::string& path);
 void WriteDetections(const DetectionSet& detections, const std::string& path);

@@ -251,8 +251,8 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
       corner.pixel = refined;
       ++local.refined;
     } else if (guess && target.type() == CalibrationTarget::Type::kAprilGrid) {
-      ++local.dropped;
-      continue;
+      corner.unrefined = true;
+      ++local.unrefined;
     } else {
       ++local.kept;
     }

@@ -31,10 +31,10 @@ namespace omnical {
 struct CornerRefinementStats {
   int refined = 0;  // moved by the refinement
   int kept = 0;     // left where the detector put them (window too small, no neighbours, or diverged)
-  // Aprilgrid corners refined through a guess that failed (occluded, cut by the rim, a
-  // neighbour missing) are dropped instead: the detector's corners are ~5x worse
+  // Aprilgrid corners whose refinement through a guess failed (occluded, cut by the rim, a
+  // neighbour missing) keep the detector's position marked `unrefined`: it is ~5x worse
   // (0.1-9 px on renders) and, unweighted among refined ones, biased the fit's mirror size.
-  int dropped = 0;
+  int unrefined = 0;
 };
 
 ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& grey, const Sensor* guess,

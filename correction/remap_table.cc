@@ -3,6 +3,7 @@
 #include "correction/parallel_rows.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 
@@ -23,6 +24,155 @@ bool RemapObjectPoint(const Sensor& sensor, const RemapSettings& settings, doubl
                                      point_in_mirror);
 }
 
+namespace {
+
+// Exact source pixels (columns) of output points (columns: col, row); NaN where the
+// output point has no object point or its projection fails.
+Eigen::Matrix2Xd ProjectOutputPoints(const Sensor& sensor, const RemapSettings& settings, const Eigen::Matrix2Xd& output_points) {
+  const ProjectionCache& cache = sensor.cache();
+  const long count = output_points.cols();
+  // Only output points with an object point go to the projector (a dummy point would
+  // fall through to its slow scalar path).
+  Eigen::Matrix3Xd points(3, count);
+  std::vector<long> source(count);
+  long with_point = 0;
+  for (long i = 0; i < count; ++i) {
+    Eigen::Vector3d point;
+    if (!RemapObjectPoint(sensor, settings, output_points(0, i), output_points(1, i), &point)) continue;
+    points.col(with_point) = cache.camera_from_mirror_rotation * point + cache.camera_from_mirror_translation;
+    source[with_point++] = i;
+  }
+  Eigen::Matrix2Xd pixels = Eigen::Matrix2Xd::Constant(2, count, NAN), projected;
+  std::vector<ProjectionStatus> statuses;
+  sensor.ProjectBatch(points.leftCols(with_point), &projected, &statuses);
+  for (long k = 0; k < with_point; ++k)
+    if (statuses[k] == ProjectionStatus::kOk) pixels.col(source[k]) = projected.col(k);
+  return pixels;
+}
+
+// Weights of the cubic through nodes at -1, 0, 1, 2 (in steps) evaluated at t in [0, 1].
+std::array<double, 4> CubicWeights(double t) {
+  return {-t * (t - 1.0) * (t - 2.0) / 6.0, (t + 1.0) * (t - 1.0) * (t - 2.0) / 2.0,
+          -(t + 1.0) * t * (t - 2.0) / 2.0, (t + 1.0) * t * (t - 1.0) / 6.0};
+}
+
+// Output pixels per kNodeSpacingDeg at the screen's centre (the larger of its two
+// directions' angles per pixel), at least 2.
+int AutomaticStep(const VirtualScreen& screen) {
+  const double cx = 0.5 * (screen.width_px - 1), cy = 0.5 * (screen.height_px - 1);
+  double pixel_rad = 0.0;
+  for (const Eigen::Vector2d& offset : {Eigen::Vector2d(0.5, 0.0), Eigen::Vector2d(0.0, 0.5)}) {
+    Eigen::Vector3d a, b;
+    if (screen.Direction(cx - offset.x(), cy - offset.y(), &a) && screen.Direction(cx + offset.x(), cy + offset.y(), &b))
+      pixel_rad = std::max(pixel_rad, std::acos(std::clamp(a.dot(b), -1.0, 1.0)));
+  }
+  if (!(pixel_rad > 0.0)) return 2;
+  return std::clamp(static_cast<int>(kNodeSpacingDeg * kPi / 180.0 / pixel_rad), 2, 64);
+}
+
+// The interpolated path (see remap_table.h). Node (i, j) sits at output point
+// ((i - 1) step, (j - 1) step): one node beyond each side, so that the pixel u in cell
+// a = u / step has the nodes a .. a + 3 around it.
+void FillByInterpolation(const Sensor& sensor, const RemapSettings& settings, const std::function<void(long)>& progress,
+                         RemapTable* table) {
+  const int step = settings.interpolation_step_px > 0 ? settings.interpolation_step_px : AutomaticStep(settings.screen);
+  const int width = table->width, height = table->height;
+  const int node_cols = (width - 1) / step + 4, node_rows = (height - 1) / step + 4;
+  const int cell_cols = node_cols - 3, cell_rows = node_rows - 3;
+  // Each node row, and its cubic along the row at every output column (NaN where a node
+  // is missing), so that a pixel needs only the cubic across 4 of these rows.
+  std::vector<double> nodes_x(static_cast<size_t>(node_cols) * node_rows), nodes_y(nodes_x.size());
+  std::vector<double> along_x(static_cast<size_t>(width) * node_rows), along_y(along_x.size());
+  std::vector<std::array<double, 4>> column_weights(width);
+  for (int u = 0; u < width; ++u) column_weights[u] = CubicWeights(double(u % step) / step);
+  ParallelRows(node_rows, settings.threads, [&](int j) {
+    Eigen::Matrix2Xd output_points(2, node_cols);
+    for (int i = 0; i < node_cols; ++i) output_points.col(i) = Eigen::Vector2d((i - 1.0) * step, (j - 1.0) * step);
+    const Eigen::Matrix2Xd pixels = ProjectOutputPoints(sensor, settings, output_points);
+    double* node_x = &nodes_x[static_cast<size_t>(j) * node_cols];
+    double* node_y = &nodes_y[static_cast<size_t>(j) * node_cols];
+    for (int i = 0; i < node_cols; ++i) node_x[i] = pixels(0, i), node_y[i] = pixels(1, i);
+    for (int u = 0; u < width; ++u) {
+      const int a = u / step;
+      const std::array<double, 4>& w = column_weights[u];
+      along_x[static_cast<size_t>(j) * width + u] = w[0] * node_x[a] + w[1] * node_x[a + 1] + w[2] * node_x[a + 2] + w[3] * node_x[a + 3];
+      along_y[static_cast<size_t>(j) * width + u] = w[0] * node_y[a] + w[1] * node_y[a + 1] + w[2] * node_y[a + 2] + w[3] * node_y[a + 3];
+    }
+  });
+
+  // Cells: interpolated only with all 16 nodes and a centre within the check tolerance.
+  std::vector<char> interpolated(static_cast<size_t>(cell_cols) * cell_rows, 0);
+  std::vector<double> worst_check(cell_rows, 0.0);
+  ParallelRows(cell_rows, settings.threads, [&](int b) {
+    const std::array<double, 4> w = CubicWeights(0.5);
+    Eigen::Matrix2Xd centres(2, cell_cols), guesses(2, cell_cols);
+    for (int a = 0; a < cell_cols; ++a) {
+      centres.col(a) = Eigen::Vector2d((a + 0.5) * step, (b + 0.5) * step);
+      Eigen::Vector2d guess = Eigen::Vector2d::Zero();
+      for (int k = 0; k < 4; ++k)
+        for (int l = 0; l < 4; ++l) {
+          const size_t node = static_cast<size_t>(b + k) * node_cols + a + l;
+          guess += w[k] * w[l] * Eigen::Vector2d(nodes_x[node], nodes_y[node]);
+        }
+      guesses.col(a) = guess;  // NaN if a node is missing
+    }
+    const Eigen::Matrix2Xd exact = ProjectOutputPoints(sensor, settings, centres);
+    for (int a = 0; a < cell_cols; ++a) {
+      const double miss = (guesses.col(a) - exact.col(a)).cwiseAbs().maxCoeff();  // NaN fails below
+      if (miss < kCellCheckTolerancePx) {
+        interpolated[static_cast<size_t>(b) * cell_cols + a] = 1;
+        worst_check[b] = std::max(worst_check[b], miss);
+      }
+    }
+  });
+
+  std::atomic<long> valid{0}, exact_pixels{0};
+  const double max_u = sensor.image_width_px() - 0.5, max_v = sensor.image_height_px() - 0.5;
+  ParallelRows(height, settings.threads, [&](int v) {
+    const int b = v / step;
+    const std::array<double, 4> w = CubicWeights(double(v % step) / step);
+    const size_t row0 = static_cast<size_t>(b) * width;
+    const size_t stride = width;
+    std::vector<int> exact_columns;
+    long row_valid = 0;
+    for (int u = 0; u < width; ++u) {
+      if (!interpolated[static_cast<size_t>(b) * cell_cols + u / step]) {
+        exact_columns.push_back(u);
+        continue;
+      }
+      const size_t k = row0 + u;
+      const double x = w[0] * along_x[k] + w[1] * along_x[k + stride] + w[2] * along_x[k + 2 * stride] + w[3] * along_x[k + 3 * stride];
+      const double y = w[0] * along_y[k] + w[1] * along_y[k + stride] + w[2] * along_y[k + 2 * stride] + w[3] * along_y[k + 3 * stride];
+      if (x < -0.5 || y < -0.5 || x > max_u || y > max_v) continue;  // the image border cuts the cell
+      const size_t i = static_cast<size_t>(v) * width + u;
+      table->map_x[i] = static_cast<float>(x);
+      table->map_y[i] = static_cast<float>(y);
+      ++row_valid;
+    }
+    if (!exact_columns.empty()) {
+      Eigen::Matrix2Xd output_points(2, exact_columns.size());
+      for (size_t c = 0; c < exact_columns.size(); ++c) output_points.col(c) = Eigen::Vector2d(exact_columns[c], v);
+      const Eigen::Matrix2Xd pixels = ProjectOutputPoints(sensor, settings, output_points);
+      for (size_t c = 0; c < exact_columns.size(); ++c) {
+        if (std::isnan(pixels(0, c))) continue;
+        const size_t i = static_cast<size_t>(v) * width + exact_columns[c];
+        table->map_x[i] = static_cast<float>(pixels(0, c));
+        table->map_y[i] = static_cast<float>(pixels(1, c));
+        ++row_valid;
+        ++exact_pixels;
+      }
+    }
+    valid += row_valid;
+    if (progress) progress(1);
+  });
+  table->valid_pixels = valid;
+  table->exact_pixels = exact_pixels;
+  table->interpolation_step_px = step;
+  table->worst_cell_check_px = *std::max_element(worst_check.begin(), worst_check.end());
+}
+
+}  // namespace
+
 RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, const std::function<void(long)>& progress) {
   const VirtualScreen& screen = settings.screen;
   RemapTable table;
@@ -36,23 +186,20 @@ RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, 
   const bool cylindrical_screen =
       screen.type == VirtualScreen::Type::kPanorama || screen.type == VirtualScreen::Type::kLonLat;
   table.used_axial_symmetry =
-      settings.allow_symmetry && sensor.is_axial() && cylindrical_screen && settings.surface.IsAxiallySymmetric();
+      settings.allow_shortcuts && sensor.is_axial() && cylindrical_screen && settings.surface.IsAxiallySymmetric();
+  if (settings.allow_shortcuts && !table.used_axial_symmetry) {
+    FillByInterpolation(sensor, settings, progress, &table);
+    return table;
+  }
   std::atomic<long> valid{0};
   // Every pixel of row v through the batch projector.
   auto project_row = [&](int v) {
-    Eigen::Matrix3Xd points(3, table.width);
-    std::vector<char> has_point(table.width, 0);
-    for (int u = 0; u < table.width; ++u) {
-      Eigen::Vector3d point;
-      has_point[u] = RemapObjectPoint(sensor, settings, u, v, &point);
-      points.col(u) = has_point[u] ? Eigen::Vector3d(rotation * point + translation) : Eigen::Vector3d::Zero();
-    }
-    Eigen::Matrix2Xd pixels;
-    std::vector<ProjectionStatus> statuses;
-    sensor.ProjectBatch(points, &pixels, &statuses);
+    Eigen::Matrix2Xd output_points(2, table.width);
+    for (int u = 0; u < table.width; ++u) output_points.col(u) = Eigen::Vector2d(u, v);
+    const Eigen::Matrix2Xd pixels = ProjectOutputPoints(sensor, settings, output_points);
     long row_valid = 0;
     for (int u = 0; u < table.width; ++u) {
-      if (!has_point[u] || statuses[u] != ProjectionStatus::kOk) continue;
+      if (std::isnan(pixels(0, u))) continue;
       const size_t i = static_cast<size_t>(v) * table.width + u;
       table.map_x[i] = static_cast<float>(pixels(0, u));
       table.map_y[i] = static_cast<float>(pixels(1, u));
@@ -60,7 +207,6 @@ RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, 
     }
     valid += row_valid;
   };
-
 
   if (table.used_axial_symmetry) {
     // Column azimuths: phi(col) = phi(0) - col * step; cos/sin once for all rows.

@@ -91,21 +91,23 @@ TEST(DetectThroughVirtualViews, FindsFarTagsTheRawDetectorMisses) {
   EXPECT_LT(std::sqrt(sum / found), 0.2);
 }
 
-// RMS pixel error of detections against a view's ground truth (by id), and how many matched.
-double RmsAgainstTruth(const ImageDetections& found, const ImageDetections& truth, int* matched) {
+// RMS pixel error of detections against a view's ground truth (by id), and how many matched;
+// corners marked unrefined (which calibrate leaves out) only where asked.
+double RmsAgainstTruth(const ImageDetections& found, const ImageDetections& truth, int* matched, bool with_unrefined = true) {
   std::map<int, Eigen::Vector2d> expected;
   for (const CornerObservation& c : truth.corners) expected[c.id] = c.pixel;
   double sum = 0.0;
   *matched = 0;
   for (const CornerObservation& c : found.corners)
-    if (const auto it = expected.find(c.id); it != expected.end()) sum += (c.pixel - it->second).squaredNorm(), ++*matched;
+    if (const auto it = expected.find(c.id); it != expected.end() && (with_unrefined || !c.unrefined)) sum += (c.pixel - it->second).squaredNorm(), ++*matched;
   return std::sqrt(sum / std::max(1, *matched));
 }
 
 // Edge-profile refinement in magnified patches through the guess brings tag corners under
 // the 0.1 px on noise-free renders (bench over every set: 0.054-0.089 px; before:
 // 0.079-0.127). Near set, two views, the design sensor as the guess. 0.1 px is the
-// requirement itself; the improvement over the unrefined corners must be real (> 20%).
+// requirement itself, for the corners a fit uses; the improvement over the unrefined
+// corners must be real (> 20%). Corners whose refinement fails stay, marked.
 TEST(RefineCorners, BringsAprilGridCornersUnderATenthOfAPixel) {
   const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/ohte-sph-near";
   const DetectionSet truth = DetectionsFromGroundTruth({set + "/near000.json", set + "/near003.json"});
@@ -119,11 +121,16 @@ TEST(RefineCorners, BringsAprilGridCornersUnderATenthOfAPixel) {
     CornerRefinementStats stats;
     const ImageDetections refined = RefineCorners(target, grey, &guess, through, &stats);
     EXPECT_GE(stats.refined, 0.95 * through.corners.size());
-    EXPECT_EQ(refined.corners.size() + stats.dropped, through.corners.size());
-    int matched_before = 0, matched_after = 0;
+    ASSERT_EQ(refined.corners.size(), through.corners.size());
+    int marked = 0;
+    for (const CornerObservation& c : refined.corners) marked += c.unrefined;
+    EXPECT_EQ(marked, stats.unrefined);
+    int matched_before = 0, matched_after = 0, matched_all = 0;
     const double rms_before = RmsAgainstTruth(through, view, &matched_before);
-    const double rms_after = RmsAgainstTruth(refined, view, &matched_after);
-    EXPECT_LE(matched_before - matched_after, stats.dropped);
+    const double rms_after = RmsAgainstTruth(refined, view, &matched_after, /*with_unrefined=*/false);
+    RmsAgainstTruth(refined, view, &matched_all);
+    EXPECT_EQ(matched_all, matched_before);
+    EXPECT_LE(matched_before - matched_after, stats.unrefined);
     before += rms_before * rms_before * matched_before;
     after += rms_after * rms_after * matched_after;
     total += matched_after;

@@ -106,18 +106,27 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
 }
 
 // Drops corner ids the target does not have; throws if none is left.
-void ForgetUnknownIds(const CalibrationTarget& target, const std::string& target_path, const std::string& source,
-                      DetectionSet* detections) {
+// The detections without corners the target does not have and without corners marked
+// unrefined (the detector's own position, ~5x worse than refined ones: unweighted among
+// them they biased the mirror's size on renders); *unrefined counts the latter.
+DetectionSet FittableCorners(const CalibrationTarget& target, const std::string& target_path, const std::string& source,
+                             DetectionSet detections, int* unrefined) {
   std::set<int> ids;
   for (const TargetCorner& c : target.corners()) ids.insert(c.id);
   int matched = 0;
-  for (ImageDetections& image : detections->images) {
+  *unrefined = 0;
+  for (ImageDetections& image : detections.images) {
     image.corners.erase(std::remove_if(image.corners.begin(), image.corners.end(),
-                                       [&](const CornerObservation& c) { return !ids.count(c.id); }),
+                                       [&](const CornerObservation& c) {
+                                         if (!ids.count(c.id)) return true;
+                                         ++matched;
+                                         *unrefined += c.unrefined;
+                                         return c.unrefined;
+                                       }),
                         image.corners.end());
-    matched += static_cast<int>(image.corners.size());
   }
   if (matched == 0) throw InputError(InputMessage(target_path, "", "the target spec matches no corner id in " + source));
+  return detections;
 }
 
 struct UsableViews {
@@ -227,8 +236,9 @@ void Run(const Options& options, const Context& context) {
   fit_options.max_iterations = options.max_iterations;
   if (const std::string why = fit_options.Check(); !why.empty()) throw InputError(why);
 
-  ForgetUnknownIds(target, options.target_path, source, &detections);
-  UsableViews views = ViewsForFit(guess, target, detections, source, context.quiet);
+  int unrefined = 0;
+  UsableViews views = ViewsForFit(guess, target, FittableCorners(target, options.target_path, source, detections, &unrefined),
+                                  source, context.quiet);
   std::optional<Sensor> refit_start;  // the previous pass's fit, where the last fit started
   FitResult fit = FitSensor(guess, target, views.detections, views.poses, fit_options);
   // Second detection pass (aprilgrid from images): the corners are refined in patches
@@ -245,8 +255,8 @@ void Run(const Options& options, const Context& context) {
     detection.threads = options.threads;
     detection.quiet = context.quiet;
     detections = DetectImages(target, options.target_path, options.images, detection).detections;
-    ForgetUnknownIds(target, options.target_path, source, &detections);
-    views = ViewsForFit(*refit_start, target, detections, source, context.quiet);
+    views = ViewsForFit(*refit_start, target, FittableCorners(target, options.target_path, source, detections, &unrefined),
+                        source, context.quiet);
     fit = FitSensor(*refit_start, target, views.detections, views.poses, fit_options);
   }
   const Sensor& fit_start = refit_start ? *refit_start : guess;
@@ -261,6 +271,7 @@ void Run(const Options& options, const Context& context) {
   result["converged"] = fit.converged;
   result["outliers"] = fit.outliers;
   result["dropped"] = fit.dropped;
+  result["unrefined_corners_left_out"] = unrefined;
   result["observations"] = fit.observations;
   result["solver_report"] = fit.solver_report;
   result["fixed_blocks"] = fit_options.fixed;

@@ -126,6 +126,12 @@ void Run(const Options& options, const Context& context) {
   j["files"] = files;
   j["valid_fraction"] = valid_fraction;
   j["used_axial_symmetry"] = table.used_axial_symmetry;
+  j["method"] = table.used_axial_symmetry ? "axial symmetry" : table.interpolation_step_px > 0 ? "interpolated grid" : "per pixel";
+  if (table.interpolation_step_px > 0)
+    j["interpolation"] = {{"step_px", table.interpolation_step_px},
+                          {"pixels_projected_one_by_one", table.exact_pixels},
+                          {"worst_cell_check_px", table.worst_cell_check_px},
+                          {"bound_px", 0.01}};
   j["generation_seconds"] = seconds;
   j["threads"] = settings.threads;
   j["exactness_check"] = {{"max_error_px", exactness_px},
@@ -141,7 +147,8 @@ void Run(const Options& options, const Context& context) {
     std::printf("%s %dx%d, objects %s, V0 = %.3f mm: %.1f%% of pixels see the mirror, %.3f s%s -> %s\n",
                 ScreenTypeName(settings.screen.type), table.width, table.height,
                 objects,
-                settings.v0_mm, 100.0 * valid_fraction, seconds, table.used_axial_symmetry ? " (axial symmetry)" : "",
+                settings.v0_mm, 100.0 * valid_fraction, seconds,
+                table.used_axial_symmetry ? " (axial symmetry)" : table.interpolation_step_px > 0 ? " (interpolated grid)" : "",
                 options.out_dir.c_str());
     std::printf("  exact to %.2g px; error at other distances (max output px):", exactness_px);
     for (const auto& r : residual) std::printf(" n=%s %.3g", r["n"].dump().c_str(), r["max_px"].get<double>());

@@ -18,7 +18,8 @@ namespace {
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 const char* const kViewOptionNames[] = {"--view",      "--size",     "--azimuth0-deg", "--elevation-deg", "--pan-deg",
                                         "--tilt-deg",  "--roll-deg", "--hfov-deg",     "--omega-max-deg", "--distance-mm",
-                                        "--n",         "--infinity", "--surface",      "--plane-normal",  "--v0"};
+                                        "--n",         "--infinity", "--surface",      "--plane-normal",  "--v0",
+                                        "--per-pixel"};
 
 std::string OptionError(const std::string& option, const std::string& problem) { return option + ": " + problem; }
 
@@ -52,6 +53,8 @@ void AddViewOptions(CLI::App& sub, ViewOptions* options, bool required_view) {
   sub.add_option("--v0", options->v0_mm, "Viewpoint V0, z on the mirror axis (mm, mirror frame); "
                                          "default: the one minimising the worst error at the distance");
   sub.add_option("--threads", options->threads, "Threads (0: all cores)")->check(CLI::NonNegativeNumber);
+  sub.add_flag("--per-pixel", options->per_pixel,
+               "Project every output pixel (no interpolated grid; its error bound is 0.01 px)");
   if (required_view) {
     sub.callback([distance, n, infinity]() {
       if (distance->count() + n->count() + infinity->count() == 0)
@@ -130,6 +133,7 @@ ResolvedView ResolveView(const Sensor& sensor, const ViewOptions& options) {
   screen.hfov_deg = options.hfov_deg;
   screen.omega_max_deg = options.omega_max_deg ? *options.omega_max_deg : omega_max;
   if (const std::string problem = screen.Check(); !problem.empty()) throw InputError("--" + problem);
+  settings.allow_shortcuts = !options.per_pixel;
   settings.threads = options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   return resolved;
 }

@@ -28,6 +28,7 @@ struct ViewOptions {
   std::vector<double> plane_normal;
   std::optional<double> v0_mm;
   int threads = 0;  // 0: all cores
+  bool per_pixel = false;  // no interpolated grid: every pixel projected (the reference)
 };
 
 // Registers the options; `required_view` makes --view and a distance mandatory.

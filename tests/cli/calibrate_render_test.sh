@@ -58,20 +58,29 @@ for axis in "xy":
     off = abs(p["decenter_%s_mm" % axis]["value"] - truth["decenter_%s_mm" % axis])
     check(off < 0.05, "sphere centre %s within 0.05 mm: %.4f mm" % (axis, off))
 
-# Detected corners (detections.json beside the results) against the render's ground truth.
+# Detected corners (detections.json beside the results) against the render's ground truth:
+# the refined ones, which the fit uses (corners whose refinement failed are marked
+# "refined": false and left out; counted apart).
 det = json.load(open(os.path.join(cal, "detections.json")))
-squares, count, visible = 0.0, 0, 0
+squares, count, visible, unrefined = 0.0, 0, 0, 0
+marked = sum(1 for view in det["images"] for c in view["corners"] if not c.get("refined", True))
 for view in det["images"]:
     gt = json.load(open(os.path.splitext(view["image"])[0] + ".json"))
     corners = {c["id"]: c["pixel"] for c in gt["targets"][0]["corners"] if c["visible"]}
     for c in view["corners"]:
-        if c["id"] in corners:
-            squares += (c["pixel"][0] - corners[c["id"]][0]) ** 2 + (c["pixel"][1] - corners[c["id"]][1]) ** 2
-            count += 1
+        if c["id"] not in corners: continue
+        if not c.get("refined", True):
+            unrefined += 1
+            continue
+        squares += (c["pixel"][0] - corners[c["id"]][0]) ** 2 + (c["pixel"][1] - corners[c["id"]][1]) ** 2
+        count += 1
 for path in glob.glob(os.path.join(render, "*.json")):
     gt = json.load(open(path))
     if "targets" in gt: visible += sum(1 for c in gt["targets"][0]["corners"] if c["visible"])
 rms = math.sqrt(squares / count)
-check(rms < 0.1, "detected corners %.4f px RMS from the ground truth (< 0.1), %d of %d visible" % (rms, count, visible))
+check(rms < 0.1, "refined corners %.4f px RMS from the ground truth (< 0.1), %d (+ %d unrefined) of %d visible"
+      % (rms, count, unrefined, visible))
+check(marked == result["unrefined_corners_left_out"],
+      "calibration.json counts the unrefined corners it left out: %d of %d" % (result["unrefined_corners_left_out"], marked))
 sys.exit(1 if failed else 0)
 PY
