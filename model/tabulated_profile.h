@@ -1,11 +1,15 @@
 // A mirror profile given as samples (r_i, z_i), e.g. a designed mirror loaded from CSV.
 //
-// Interpolated by a natural cubic spline in s = r^2: C2, so the curvatures the optics
-// analysis needs (f'') are continuous, and smooth across the axis by construction.
+// Interpolated by a cubic spline in s = r^2: C2, so the curvatures the optics analysis
+// needs (f'') are continuous, and smooth across the axis by construction. Natural at the
+// vertex; at the last sample natural too, or clamped to the table's slope dz/dr where the
+// table has one (a third column): a natural end bent a designed mirror's rim rays by
+// 2.6 % of the imaging law (tests/mirror_design_test.cc).
 // ceres::CubicInterpolator is only C1 (Catmull-Rom) on a uniform grid, hence our own.
 // The table is data, not a parameter: it is never refined by calibration.
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,9 +20,10 @@ namespace omnical {
 
 class CubicSplineInR2 {
  public:
-  // radius_mm strictly increasing from 0; at least 4 samples. Throws std::invalid_argument
-  // with the reason when the samples cannot make a profile.
-  CubicSplineInR2(std::vector<double> radius_mm, std::vector<double> sag_mm);
+  // radius_mm strictly increasing from 0; at least 4 samples; end_slope_dz_dr clamps the
+  // last knot (NaN: natural). Throws std::invalid_argument with the reason when the
+  // samples cannot make a profile.
+  CubicSplineInR2(std::vector<double> radius_mm, std::vector<double> sag_mm, double end_slope_dz_dr = NAN);
 
   // Index of the segment [s_i, s_i+1] holding r2 (clamped to the first/last segment,
   // which then extrapolates with its cubic).
@@ -83,7 +88,7 @@ struct TabulatedProfile {
   }
 };
 
-// Loads "r,z[,...]" rows (mm; further columns such as dz/dr are ignored).
+// Loads "r,z[,dz/dr,...]" rows (mm); a dz/dr column on every row clamps the end slope.
 // Throws InputError naming the file, the line and the problem.
 std::shared_ptr<const CubicSplineInR2> LoadProfileTable(const std::string& path);
 

@@ -18,11 +18,12 @@ Command CalibrateCommand();
 Command RemapCommand();
 Command UnwarpCommand();
 Command ExportCentralCommand();
+Command DesignCommand();
 
 inline std::vector<Command> AllCommands() {
   return {ProjectCommand(), UnprojectCommand(), CharacterizeCommand(), ParallaxCommand(), TargetCommand(),
           RenderCommand(),  DetectCommand(),    CalibrateCommand(), RemapCommand(),    UnwarpCommand(),
-          ExportCentralCommand()};
+          ExportCentralCommand(), DesignCommand()};
 }
 
 }  // namespace omnical::cli

@@ -12,3 +12,17 @@ summary() {
   echo "$1: $passed passed, $failed failed"
   [ "$failed" -eq 0 ]
 }
+# expect_error NAME EXPECTED_SUBSTRING OUT -- ARGS...: exit 2, one stderr line with the
+# substring, nothing at OUT afterwards (needs $omnical).
+expect_error() {
+  local name=$1 expected=$2 out=$3
+  shift 4
+  rm -rf "$out"
+  "$omnical" "$@" >"$work/stdout" 2>"$work/stderr"
+  local code=$?
+  if [ "$code" -ne 2 ]; then fail "$name: exit code $code, expected 2 ($(cat "$work/stderr"))"; return; fi
+  if [ "$(wc -l <"$work/stderr")" -ne 1 ]; then fail "$name: not one stderr line: $(cat "$work/stderr")"; return; fi
+  if ! grep -qF -- "$expected" "$work/stderr"; then fail "$name: message lacks '$expected': $(cat "$work/stderr")"; return; fi
+  if [ -e "$out" ] && [ -n "$(ls -A "$out" 2>/dev/null)" ]; then fail "$name: left output in $out"; return; fi
+  pass
+}

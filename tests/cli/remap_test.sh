@@ -12,20 +12,6 @@ omni=$source_dir/datasets-synthetic/rendered/ohte-sph-misaligned-near/near-front
 omni_aligned=$source_dir/datasets-synthetic/rendered/ohte-sph-near/near-front.png  # 1000 x 1000
 source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
 
-# expect_error NAME EXPECTED_SUBSTRING OUT -- ARGS...: exit 2, one stderr line with the
-# substring, nothing at OUT afterwards.
-expect_error() {
-  local name=$1 expected=$2 out=$3
-  shift 4
-  rm -rf "$out"
-  "$omnical" "$@" >"$work/stdout" 2>"$work/stderr"
-  local code=$?
-  if [ "$code" -ne 2 ]; then fail "$name: exit code $code, expected 2 ($(cat "$work/stderr"))"; return; fi
-  if [ "$(wc -l <"$work/stderr")" -ne 1 ]; then fail "$name: not one stderr line: $(cat "$work/stderr")"; return; fi
-  if ! grep -qF -- "$expected" "$work/stderr"; then fail "$name: message lacks '$expected': $(cat "$work/stderr")"; return; fi
-  if [ -e "$out" ] && [ -n "$(ls -A "$out" 2>/dev/null)" ]; then fail "$name: left output in $out"; return; fi
-  pass
-}
 
 # --- all three formats from one run ------------------------------------------------------
 maps=$work/maps
