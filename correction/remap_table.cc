@@ -50,6 +50,33 @@ Eigen::Matrix2Xd ProjectOutputPoints(const Sensor& sensor, const RemapSettings& 
   return pixels;
 }
 
+// The image's pixel area (centres at integers, edges at -0.5 and size - 0.5): the image
+// border can cut an otherwise imaged field. Made once per table: Sensor's accessors
+// visit its variant, too slow per pixel.
+struct ImageArea {
+  explicit ImageArea(const Sensor& sensor) : max_u(sensor.image_width_px() - 0.5), max_v(sensor.image_height_px() - 0.5) {}
+  bool Contains(double x, double y) const { return x >= -0.5 && y >= -0.5 && x <= max_u && y <= max_v; }
+  double max_u, max_v;
+};
+
+// Projects the output pixels (columns[i], v) exactly into the table; returns how many
+// have a source pixel.
+long ProjectColumnsOfRow(const Sensor& sensor, const RemapSettings& settings, int v, const std::vector<int>& columns,
+                         RemapTable* table) {
+  Eigen::Matrix2Xd output_points(2, columns.size());
+  for (size_t c = 0; c < columns.size(); ++c) output_points.col(c) = Eigen::Vector2d(columns[c], v);
+  const Eigen::Matrix2Xd pixels = ProjectOutputPoints(sensor, settings, output_points);
+  long valid = 0;
+  for (size_t c = 0; c < columns.size(); ++c) {
+    if (std::isnan(pixels(0, c))) continue;
+    const size_t i = static_cast<size_t>(v) * table->width + columns[c];
+    table->map_x[i] = static_cast<float>(pixels(0, c));
+    table->map_y[i] = static_cast<float>(pixels(1, c));
+    ++valid;
+  }
+  return valid;
+}
+
 // Weights of the cubic through nodes at -1, 0, 1, 2 (in steps) evaluated at t in [0, 1].
 std::array<double, 4> CubicWeights(double t) {
   return {-t * (t - 1.0) * (t - 2.0) / 6.0, (t + 1.0) * (t - 1.0) * (t - 2.0) / 2.0,
@@ -127,7 +154,7 @@ void FillByInterpolation(const Sensor& sensor, const RemapSettings& settings, co
   });
 
   std::atomic<long> valid{0}, exact_pixels{0};
-  const double max_u = sensor.image_width_px() - 0.5, max_v = sensor.image_height_px() - 0.5;
+  const ImageArea image(sensor);
   ParallelRows(height, settings.threads, [&](int v) {
     const int b = v / step;
     const std::array<double, 4> w = CubicWeights(double(v % step) / step);
@@ -143,24 +170,16 @@ void FillByInterpolation(const Sensor& sensor, const RemapSettings& settings, co
       const size_t k = row0 + u;
       const double x = w[0] * along_x[k] + w[1] * along_x[k + stride] + w[2] * along_x[k + 2 * stride] + w[3] * along_x[k + 3 * stride];
       const double y = w[0] * along_y[k] + w[1] * along_y[k + stride] + w[2] * along_y[k + 2 * stride] + w[3] * along_y[k + 3 * stride];
-      if (x < -0.5 || y < -0.5 || x > max_u || y > max_v) continue;  // the image border cuts the cell
+      if (!image.Contains(x, y)) continue;
       const size_t i = static_cast<size_t>(v) * width + u;
       table->map_x[i] = static_cast<float>(x);
       table->map_y[i] = static_cast<float>(y);
       ++row_valid;
     }
     if (!exact_columns.empty()) {
-      Eigen::Matrix2Xd output_points(2, exact_columns.size());
-      for (size_t c = 0; c < exact_columns.size(); ++c) output_points.col(c) = Eigen::Vector2d(exact_columns[c], v);
-      const Eigen::Matrix2Xd pixels = ProjectOutputPoints(sensor, settings, output_points);
-      for (size_t c = 0; c < exact_columns.size(); ++c) {
-        if (std::isnan(pixels(0, c))) continue;
-        const size_t i = static_cast<size_t>(v) * width + exact_columns[c];
-        table->map_x[i] = static_cast<float>(pixels(0, c));
-        table->map_y[i] = static_cast<float>(pixels(1, c));
-        ++row_valid;
-        ++exact_pixels;
-      }
+      const long projected = ProjectColumnsOfRow(sensor, settings, v, exact_columns, table);
+      row_valid += projected;
+      exact_pixels += projected;
     }
     valid += row_valid;
     if (progress) progress(1);
@@ -193,22 +212,12 @@ RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, 
   }
   std::atomic<long> valid{0};
   // Every pixel of row v through the batch projector.
-  auto project_row = [&](int v) {
-    Eigen::Matrix2Xd output_points(2, table.width);
-    for (int u = 0; u < table.width; ++u) output_points.col(u) = Eigen::Vector2d(u, v);
-    const Eigen::Matrix2Xd pixels = ProjectOutputPoints(sensor, settings, output_points);
-    long row_valid = 0;
-    for (int u = 0; u < table.width; ++u) {
-      if (std::isnan(pixels(0, u))) continue;
-      const size_t i = static_cast<size_t>(v) * table.width + u;
-      table.map_x[i] = static_cast<float>(pixels(0, u));
-      table.map_y[i] = static_cast<float>(pixels(1, u));
-      ++row_valid;
-    }
-    valid += row_valid;
-  };
+  std::vector<int> all_columns(table.width);
+  for (int u = 0; u < table.width; ++u) all_columns[u] = u;
+  auto project_row = [&](int v) { valid += ProjectColumnsOfRow(sensor, settings, v, all_columns, &table); };
 
   if (table.used_axial_symmetry) {
+    const ImageArea image(sensor);
     // Column azimuths: phi(col) = phi(0) - col * step; cos/sin once for all rows.
     std::vector<double> cos_phi(table.width), sin_phi(table.width);
     for (int u = 0; u < table.width; ++u) {
@@ -240,8 +249,7 @@ RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, 
         long row_valid = 0;
         for (int u = 0; u < table.width; ++u) {
           const double x = cu + au * cos_phi[u], y = cv + av * sin_phi[u];
-          // The image border can cut an otherwise imaged circle.
-          if (x < -0.5 || y < -0.5 || x > sensor.image_width_px() - 0.5 || y > sensor.image_height_px() - 0.5) continue;
+          if (!image.Contains(x, y)) continue;
           const size_t i = static_cast<size_t>(v) * table.width + u;
           table.map_x[i] = static_cast<float>(x);
           table.map_y[i] = static_cast<float>(y);

@@ -95,10 +95,8 @@ void RunOde(const OdeOptions& options, const Context& context) {
     curves.push_back(TraceLawRatio(sensor, spec, pitch_mm, factor * spec.distance_mm, rho_from_mm, design.rho_end_mm,
                                    kRatioIntervals));
   const LawRatioCurve& reference = curves[2];
-  double worst = 0.0;
-  for (double r : reference.ratio) worst = std::max(worst, std::abs(r - 1.0));  // NaN -> stays, caught below
-  for (double r : reference.ratio)
-    if (!std::isfinite(r)) worst = HUGE_VAL;
+  double worst = 0.0;  // HUGE_VAL where a ray missed
+  for (double r : reference.ratio) worst = std::isfinite(r) ? std::max(worst, std::abs(r - 1.0)) : HUGE_VAL;
 
   nlohmann::json j;
   j["phi0_deg"] = design.phi0_deg;
