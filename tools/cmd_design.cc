@@ -16,8 +16,10 @@
 #include "model/designed_sensor.h"
 #include "model/input_error.h"
 #include "model/mirror_design_ode.h"
+#include "tools/cmd_design_fit.h"
 #include "tools/commands.h"
 #include "tools/plot.h"
+#include "tools/profile_drawing.h"
 
 namespace omnical::cli {
 namespace {
@@ -161,6 +163,23 @@ void RunOde(const OdeOptions& options, const Context& context) {
   for (const ProfileSample& s : design.profile) rays.series.back().y.push_back(s.height_mm);
   WritePng((dir / "law_ratio.png").string(), RenderPanel(ratio, 900, 500));
   WritePng((dir / "profile.png").string(), TilePanels({RenderPanel(profile, 700, 450), RenderPanel(rays, 700, 450)}, 2));
+  ProfileDrawing drawing;
+  for (const ProfileSample& s : design.profile) {
+    drawing.radius_mm.push_back(s.radius_mm);
+    drawing.sag_mm.push_back(s.height_mm - vertex_mm);
+    drawing.slope.push_back(s.slope);
+  }
+  const char* law_name = spec.law.kind == ImagingLaw::Kind::kLinear     ? "linear"
+                         : spec.law.kind == ImagingLaw::Kind::kLogPolar ? "log-polar"
+                                                                        : "tabulated";
+  char title[160], lens_note[200], plane_note[120];
+  std::snprintf(title, sizeof title, "omnical design ode: %s law on a cylinder at d = %.0f mm", law_name, spec.distance_mm);
+  std::snprintf(lens_note, sizeof lens_note, "Pinhole (f = %.3f mm) %.3f mm below the vertex (m),", spec.focal_length_mm,
+                vertex_mm - spec.focal_length_mm);
+  drawing.title = title;
+  std::snprintf(plane_note, sizeof plane_note, "image plane %.3f mm below the vertex (F0).", vertex_mm);
+  drawing.notes = {lens_note, plane_note, "Full table: profile.csv; the model: sensor.yaml."};
+  WriteProfileDrawing(drawing, (dir / "profile_drawing.svg").string(), (dir / "profile_drawing.png").string());
   WriteFileAtomically((dir / "design.json").string(), [&](std::ostream& out) { out << j.dump(2) << '\n'; });
 
   if (!context.quiet)
@@ -173,9 +192,10 @@ void RunOde(const OdeOptions& options, const Context& context) {
 }  // namespace
 
 Command DesignCommand() {
-  return {"design", "Mirror design: the reflection ODE for an imaging law (design ode)",
+  return {"design", "Mirror design: the reflection ODE for an imaging law (ode), or a profile family fitted to rim targets (fit)",
           [](CLI::App& sub, const Context& context) -> CommandAction {
             auto options = std::make_shared<OdeOptions>();
+            auto fit_options = std::make_shared<DesignFitOptions>();
             sub.require_subcommand(1);
             CLI::App* ode = sub.add_subcommand("ode", "Gächter's reflection ODE: a profile imaging a cylinder by a law h(rho)");
             auto* spec = ode->add_option("--spec", options->spec_path, "Design spec (YAML, see datasets-synthetic/designs)");
@@ -202,7 +222,14 @@ Command DesignCommand() {
             ode->callback([options, spec, law]() {
               if (spec->count() + law->count() == 0) throw CLI::RequiredError("--spec or --law");
             });
-            return [options, &context]() { RunOde(*options, context); };
+            CLI::App* fit = sub.add_subcommand("fit", "Ohte & Tsuzuki's design by parameters (Table 1), solved with Ceres");
+            AddDesignFitOptions(fit, fit_options.get());
+            return [options, fit_options, fit, &context]() {
+              if (fit->parsed())
+                RunDesignFit(*fit_options, context);
+              else
+                RunOde(*options, context);
+            };
           }};
 }
 
