@@ -3,10 +3,15 @@
 //                                                      on the rounded float maps, pixel for pixel
 //   mapcheck dump MAPS.yml.gz X.f32 Y.f32             the float maps as raw little-endian float32
 //   mapcheck same-size IMAGE W H                      the image is W x H
+//   mapcheck compare MAPS_A.yml.gz MAPS_B.yml.gz      prints "max_px rms_px common flipped": the
+//                                                      distance between the two tables' omni
+//                                                      pixels where both are valid, their
+//                                                      count, and how many are valid in one only
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -54,6 +59,26 @@ int main(int argc, char** argv) {
     const cv::Mat image = cv::imread(argv[2], cv::IMREAD_UNCHANGED);
     return !image.empty() && image.cols == std::atoi(argv[3]) && image.rows == std::atoi(argv[4]) ? 0 : 1;
   }
-  std::fprintf(stderr, "usage: mapcheck ffmpeg|dump|same-size ...\n");
+  if (mode == "compare" && argc == 4) {
+    cv::Mat ax, ay, bx, by;
+    if (!ReadMaps(argv[2], &ax, &ay) || !ReadMaps(argv[3], &bx, &by) || ax.size() != bx.size())
+      return std::fprintf(stderr, "unreadable or differently sized maps\n"), 1;
+    double worst = 0.0, squares = 0.0;
+    long common = 0, flipped = 0;
+    for (int r = 0; r < ax.rows; ++r) {
+      for (int c = 0; c < ax.cols; ++c) {
+        const bool a_valid = ax.at<float>(r, c) >= 0.0f, b_valid = bx.at<float>(r, c) >= 0.0f;
+        if (a_valid != b_valid) ++flipped;
+        if (!a_valid || !b_valid) continue;
+        const double d = std::hypot(ax.at<float>(r, c) - bx.at<float>(r, c), ay.at<float>(r, c) - by.at<float>(r, c));
+        worst = std::max(worst, d);
+        squares += d * d;
+        ++common;
+      }
+    }
+    std::printf("%.6f %.6f %ld %ld\n", worst, common > 0 ? std::sqrt(squares / common) : 0.0, common, flipped);
+    return common > 0 ? 0 : 1;
+  }
+  std::fprintf(stderr, "usage: mapcheck ffmpeg|dump|same-size|compare ...\n");
   return 2;
 }
