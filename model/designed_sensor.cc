@@ -14,7 +14,7 @@ Sensor SensorFromOdeDesign(const OdeDesignSpec& spec, const OdeDesign& design, i
     sag_mm.push_back(s.height_mm - design.profile.front().height_mm);
   }
   Catadioptric<double, TabulatedProfile, PinholeLens> model;
-  model.mirror.spline = std::make_shared<const CubicSplineInR2>(radius_mm, sag_mm, design.profile.back().slope);
+  model.mirror.spline = std::make_shared<const ProfileSpline>(radius_mm, sag_mm, design.profile.back().slope, design.profile.front().slope);
   model.mirror.source = table_path;
   const double focal_px = spec.focal_length_mm / PixelPitchMm(design, image_size_px);
   const double centre_px = 0.5 * (image_size_px - 1);

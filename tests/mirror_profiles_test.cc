@@ -74,10 +74,40 @@ TEST(TabulatedProfile, InterpolatesASmoothProfile) {
   EXPECT_LT(worst_slope, 1e-5);
 }
 
+// A cone point (the reflection ODE's vertex when the centre pixel looks off the axis):
+// z = k r + c r^2 + e r^3 tabulated on 400 rows with its slope. Splined in r, clamped to
+// k at the vertex, the sag, slope and curvature follow it to the axis; a spline in r^2
+// cannot (z ~ k sqrt(s)), which is what the uniform design's law lost near the centre.
+TEST(TabulatedProfile, ConePointFollowsTheTableToTheAxis) {
+  const double k = 0.23, c = 0.004, e = 1e-5, rim = 30.0;
+  auto sag = [&](double r) { return r * (k + r * (c + r * e)); };
+  auto slope = [&](double r) { return k + r * (2.0 * c + 3.0 * e * r); };
+  std::vector<double> r, z;
+  for (int i = 0; i < 400; ++i) r.push_back(rim * i / 399.0), z.push_back(sag(r.back()));
+  const ProfileSpline cone(r, z, slope(rim), k);
+  ASSERT_TRUE(cone.cone_tip());
+  for (double x : {1e-6, 1e-3, 0.05, 0.2, 3.0, 17.3, 29.9}) {
+    const SagDerivatives<double> g = cone.Evaluate(x * x);
+    double dz_dr = 0.0, d2z_dr2 = 0.0;
+    RadialSlopes(g, x, &dz_dr, &d2z_dr2);
+    // The cubic through exact samples of a cubic: round-off only, growing as 1/r in the
+    // s-derivatives' conversion near the axis.
+    EXPECT_NEAR(g.z, sag(x), 1e-12) << "r = " << x;
+    EXPECT_NEAR(dz_dr, slope(x), 1e-9) << "r = " << x;
+    EXPECT_NEAR(d2z_dr2, 2.0 * c + 6.0 * e * x, 1e-9 / x) << "r = " << x;
+  }
+  // The same table without its slope column is a smooth r^2 spline and misses the cone
+  // near the axis by orders of magnitude more.
+  const ProfileSpline smooth(r, z, slope(rim));
+  double dz_dr = 0.0, d2z_dr2 = 0.0;
+  RadialSlopes(smooth.Evaluate(0.05 * 0.05), 0.05, &dz_dr, &d2z_dr2);
+  EXPECT_GT(std::abs(dz_dr - slope(0.05)), 1e-3);
+}
+
 TEST(TabulatedProfile, RejectsBadTables) {
-  EXPECT_THROW(CubicSplineInR2({0.0, 1.0, 1.0, 2.0}, {0, 1, 1, 2}), std::invalid_argument);  // r not increasing
-  EXPECT_THROW(CubicSplineInR2({0.5, 1.0, 1.5, 2.0}, {0, 1, 1, 2}), std::invalid_argument);  // no vertex row
-  EXPECT_THROW(CubicSplineInR2({0.0, 1.0}, {0, 1}), std::invalid_argument);                  // too few rows
+  EXPECT_THROW(ProfileSpline({0.0, 1.0, 1.0, 2.0}, {0, 1, 1, 2}), std::invalid_argument);  // r not increasing
+  EXPECT_THROW(ProfileSpline({0.5, 1.0, 1.5, 2.0}, {0, 1, 1, 2}), std::invalid_argument);  // no vertex row
+  EXPECT_THROW(ProfileSpline({0.0, 1.0}, {0, 1}), std::invalid_argument);                  // too few rows
   const std::string path = testing::PrivateTempDir() + "/bad_profile.csv";
   std::ofstream(path) << "r,z\n0,0\n1,0.1\nabc,0.2\n";
   try {

@@ -164,7 +164,7 @@ TEST(TabulatedProfile, TiltedSolverConvergesNearTheRim) {
     z.push_back(sampled.spline->sag_mm()[i]);
   }
   TabulatedProfile<double> to_rim;
-  to_rim.spline = std::make_shared<const CubicSplineInR2>(r, z);
+  to_rim.spline = std::make_shared<const ProfileSpline>(r, z);
   for (double tilt_deg : {5.0, 10.0}) {
     auto model = testing::MakeModel<TabulatedProfile, OrthographicLens>(to_rim, 150.0, false);
     model.rim_radius_mm = r.back();

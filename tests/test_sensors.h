@@ -57,7 +57,7 @@ inline TabulatedProfile<double> SampledEdiProfile() {
     z.push_back(edi.EvaluateSag(r.back() * r.back()).z);
   }
   TabulatedProfile<double> profile;
-  profile.spline = std::make_shared<const CubicSplineInR2>(r, z);
+  profile.spline = std::make_shared<const ProfileSpline>(r, z);
   profile.source = "sampled-edi";
   return profile;
 }
