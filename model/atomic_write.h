@@ -19,4 +19,13 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
 // return and removed if write throws.
 void WriteFileAtomicallyByPath(const std::string& path, const std::function<void(const std::string&)>& write);
 
+// create_directories with omnical's error: InputError "dir: cannot create output
+// directory (reason)" instead of a filesystem_error.
+void CreateOutputDirectory(const std::string& dir);
+
+// Installs handlers for SIGINT, SIGTERM and SIGHUP that delete the temporary files being
+// written at that moment, then let the signal end the process as it would have: Ctrl-C
+// leaves the previous outputs and no stray temporary file (the CLI calls it first).
+void RemoveTemporaryFilesOnInterrupt();
+
 }  // namespace omnical

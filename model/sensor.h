@@ -60,6 +60,8 @@ Sensor LoadSensorYaml(const std::string& path);
 Sensor ParseSensorYaml(const std::string& yaml_text, const std::string& source);
 // Writes the same format (atomically). Throws InputError if the file cannot be written.
 void SaveSensorYaml(const Sensor& sensor, const std::string& path);
+// The text SaveSensorYaml writes.
+std::string SensorYamlText(const Sensor& sensor);
 // Checks a model the way the reader does; returns "field: problem" or empty.
 std::string ValidateSensorModel(const SensorModel& model);
 

@@ -284,7 +284,7 @@ Sensor ParseSensorYaml(const std::string& yaml_text, const std::string& source) 
   return SensorFromRoot(root, reader);
 }
 
-void SaveSensorYaml(const Sensor& sensor, const std::string& path) {
+std::string SensorYamlText(const Sensor& sensor) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);
   std::visit(
@@ -337,7 +337,12 @@ void SaveSensorYaml(const Sensor& sensor, const std::string& path) {
         out << YAML::EndMap;
       },
       sensor.model());
-  WriteFileAtomically(path, [&](std::ostream& stream) { stream << out.c_str() << "\n"; });
+  return std::string(out.c_str()) + "\n";
+}
+
+void SaveSensorYaml(const Sensor& sensor, const std::string& path) {
+  const std::string text = SensorYamlText(sensor);
+  WriteFileAtomically(path, [&](std::ostream& stream) { stream << text; });
 }
 
 }  // namespace omnical

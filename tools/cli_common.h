@@ -3,7 +3,9 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <opencv2/core.hpp>
 
+#include <cstdlib>
 #include <functional>
 #include <iosfwd>
 #include <string>
@@ -22,7 +24,20 @@ struct Command {
   std::function<CommandAction(CLI::App& sub, const Context& context)> add;
 };
 
+// Number checks with plain messages (CLI11's PositiveNumber prints its range up to
+// DBL_MAX in full). Non-finite numbers never get here (main.cc refuses them).
+inline const CLI::Validator kPositive(
+    [](std::string& text) { return std::strtod(text.c_str(), nullptr) > 0.0 ? std::string() : "must be > 0 (got " + text + ")"; },
+    "> 0");
+inline const CLI::Validator kNonNegative(
+    [](std::string& text) { return std::strtod(text.c_str(), nullptr) >= 0.0 ? std::string() : "must be >= 0 (got " + text + ")"; },
+    ">= 0");
+
 // Writes to path atomically, or to stdout when path is empty or "-".
 void WriteOutput(const std::string& path, const std::function<void(std::ostream&)>& write);
+
+// cv::imread with a check first that a PNG is complete (its last chunk is IEND): libpng
+// would print its own "Read Error" line for a truncated file. Empty Mat if unreadable.
+cv::Mat ReadImage(const std::string& path, int flags);
 
 }  // namespace omnical::cli

@@ -48,7 +48,7 @@ std::set<std::string> SplitList(const std::string& text) {
 }
 
 void WriteReport(const std::filesystem::path& dir, const DetectionSet& detections, const FitResult& fit) {
-  std::filesystem::create_directories(dir);
+  CreateOutputDirectory(dir);
   double worst = 0.0;
   std::vector<double> magnitudes;
   for (const auto& view : fit.residuals_px)
@@ -59,7 +59,7 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
   cv::Mat coverage(detections.image_height_px, detections.image_width_px, CV_8UC3, cv::Scalar(30, 30, 30));
   for (size_t v = 0; v < detections.images.size(); ++v) {
     const ImageDetections& image = detections.images[v];
-    cv::Mat picture = cv::imread(image.image, cv::IMREAD_COLOR);
+    cv::Mat picture = ReadImage(image.image, cv::IMREAD_COLOR);
     if (picture.empty()) picture = cv::Mat(detections.image_height_px, detections.image_width_px, CV_8UC3, cv::Scalar(40, 40, 40));
     for (size_t i = 0; i < image.corners.size(); ++i) {
       const cv::Point2d p(image.corners[i].pixel.x(), image.corners[i].pixel.y());
@@ -129,6 +129,10 @@ DetectionSet FittableCorners(const CalibrationTarget& target, const std::string&
   return detections;
 }
 
+// Targets whose distances from the lens span less than this ratio count as "one
+// distance" (the warning above the fit's results).
+constexpr double kOneDistanceRatio = 1.5;
+
 struct UsableViews {
   DetectionSet detections;  // the views with a starting pose
   std::vector<TargetPose> poses;
@@ -176,7 +180,7 @@ UsableViews ViewsForFit(const Sensor& start, const CalibrationTarget& target, co
 std::optional<RimCircle> RimOfImages(const DetectionSet& detections) {
   std::vector<RimCircle> circles;
   for (const ImageDetections& image : detections.images) {
-    const cv::Mat grey = cv::imread(image.image, cv::IMREAD_GRAYSCALE);
+    const cv::Mat grey = ReadImage(image.image, cv::IMREAD_GRAYSCALE);
     if (grey.empty()) continue;
     if (auto circle = DetectRimCircle(grey)) circles.push_back(*circle);
   }
@@ -327,6 +331,27 @@ void Run(const Options& options, const Context& context) {
                               ? "% of its value): fx and m trade off; fix m from the design (--fix m) or the lens scale, "
                                 "or add views at more distances"
                               : "% of its value): views covering more of the mirror, at more distances, help"));
+  // One distance: a non-central mirror's shape shows in how its image changes with the
+  // object's distance (the viewpoints slide), so with every board at about the same range
+  // the shape trades off against m and the lens scale.
+  const bool shape_free = std::any_of(fit.parameters.begin(), fit.parameters.end(), [](const ParameterEstimate& p) {
+    return !p.fixed && (p.name == "A_mm" || p.name == "B_mm" ||
+                        (p.name.size() >= 2 && p.name[0] == 'c' && std::isdigit(static_cast<unsigned char>(p.name[1]))));
+  });
+  double nearest_mm = HUGE_VAL, farthest_mm = 0.0;
+  for (const TargetPose& pose : fit.poses) {
+    nearest_mm = std::min(nearest_mm, pose.camera_from_target_translation_mm.norm());
+    farthest_mm = std::max(farthest_mm, pose.camera_from_target_translation_mm.norm());
+  }
+  result["target_distance_mm"] = {{"nearest", nearest_mm}, {"farthest", farthest_mm}};
+  if (shape_free && farthest_mm < kOneDistanceRatio * nearest_mm) {
+    char text[300];
+    std::snprintf(text, sizeof text,
+                  "all targets are at one distance (%.0f-%.0f mm from the lens) while the mirror shape is free: the shape "
+                  "is weakly determined; add views at least %.1fx nearer or farther, or fix it (--fix shape)",
+                  nearest_mm, farthest_mm, kOneDistanceRatio);
+    warnings.push_back(text);
+  }
   result["warnings"] = warnings;
   for (size_t v = 0; v < usable.images.size(); ++v) result["per_view_rms_px"][usable.images[v].image] = fit.per_view_rms_px[v];
   for (const ParameterEstimate& p : fit.parameters)
@@ -344,7 +369,7 @@ void Run(const Options& options, const Context& context) {
   }
 
   const std::filesystem::path dir(options.out_dir);
-  std::filesystem::create_directories(dir);
+  CreateOutputDirectory(dir);
   SaveSensorYaml(*fit.sensor, (dir / "sensor.yaml").string());
   if (!options.images.empty()) WriteDetections(detections, (dir / "detections.json").string());
   WriteFileAtomically((dir / "calibration.json").string(), [&](std::ostream& out) { out << result.dump(2) << '\n'; });

@@ -10,6 +10,7 @@
 #include <optional>
 #include <ostream>
 
+#include "model/atomic_write.h"
 #include "model/input_error.h"
 #include "model/optics.h"
 #include "tools/commands.h"
@@ -209,7 +210,7 @@ void Run(const Options& options, const Context& context) {
   const Sensor sensor = LoadSensorYaml(options.sensor_path);
   if (const std::string why = RimOutsideImage(sensor); !why.empty())
     throw InputError(InputMessage(options.sensor_path, "", why));
-  std::filesystem::create_directories(options.out_dir);
+  CreateOutputDirectory(options.out_dir);
   const double rim = sensor.rim_radius_mm();
   const std::vector<FieldSample> field = AnalyzeField(sensor, options.samples, options.near_n * rim);
 
@@ -314,14 +315,14 @@ Command CharacterizeCommand() {
             sub.add_option("--sensor", options->sensor_path, "Sensor file (YAML)")->required();
             sub.add_option("--out", options->out_dir, "Output directory (CSV, summary.json, PNG figures)")->required();
             sub.add_option("--lens-f", options->lens_focal_mm, "Lens focal length, mm (default: fx x pixel size)")
-                ->check(CLI::PositiveNumber);
-            sub.add_option("--f-number", options->f_number, "Lens f-number F")->check(CLI::PositiveNumber)->capture_default_str();
+                ->check(kPositive);
+            sub.add_option("--f-number", options->f_number, "Lens f-number F")->check(kPositive)->capture_default_str();
             sub.add_option("--pixel-um", options->pixel_um, "Pixel size, um (the permissible circle of confusion)")
-                ->check(CLI::PositiveNumber)->capture_default_str();
+                ->check(kPositive)->capture_default_str();
             sub.add_option("--focus-mm", options->focus_mm, "In-focus distance L0, mm (default: searched)")
-                ->check(CLI::PositiveNumber);
+                ->check(kPositive);
             sub.add_option("--near-n", options->near_n, "Near object distance for virtual images, mirror radii")
-                ->check(CLI::PositiveNumber)->capture_default_str();
+                ->check(kPositive)->capture_default_str();
             sub.add_option("--samples", options->samples, "Samples over the mirror radius")
                 ->check(CLI::Range(10, 100000))->capture_default_str();
             return [options, &context]() { Run(*options, context); };

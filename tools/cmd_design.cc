@@ -66,7 +66,7 @@ void RunOde(const OdeOptions& options, const Context& context) {
   const OdeDesignSpec spec = SpecFromOptions(options);
   const OdeDesign design = SolveMirrorOde(spec, options.samples);
   const std::filesystem::path dir(options.out_dir);
-  std::filesystem::create_directories(dir);
+  CreateOutputDirectory(dir);
   const double vertex_mm = design.profile.front().height_mm;
 
   WriteFileAtomically((dir / "profile.csv").string(), [&](std::ostream& out) {

@@ -80,7 +80,7 @@ void AddDesignFitOptions(CLI::App* fit, DesignFitOptions* o) {
                   "freedom left)")
       ->check(CLI::IsMember({"equidistant", "svp", "aspect", "area"}));
   fit->add_option("--rim-radius-mm", o->rim_radius_mm, "Mirror radius M at the rim (mm): scales the normalised design")
-      ->check(CLI::PositiveNumber)
+      ->check(kPositive)
       ->capture_default_str();
   fit->add_option("--image-size", o->image_size_px, "Square image; the rim images at half its width (the paper's 2N)")
       ->check(CLI::Range(64, 20000))
@@ -126,7 +126,7 @@ void RunDesignFit(const DesignFitOptions& o, const Context& context) {
   const Sensor sensor = SensorFromFitDesign(design, spec, o.rim_radius_mm, o.image_size_px);
   const CharacteristicReport achieved = MeasureCharacteristics(sensor, kSamples);
   const std::filesystem::path dir(o.out_dir);
-  std::filesystem::create_directories(dir);
+  CreateOutputDirectory(dir);
   SaveSensorYaml(sensor, (dir / "sensor.yaml").string());
 
   // The profile in mm, and the drawing from it.

@@ -124,7 +124,7 @@ void Run(const Options& options, const Context& context) {
   progress.Advance();
 
   const std::filesystem::path dir(options.out_dir);
-  std::filesystem::create_directories(dir);
+  CreateOutputDirectory(dir);
   nlohmann::json result;
   result["model"] = options.model;
   result["sensor"] = options.sensor_path;

@@ -16,6 +16,7 @@
 #include "correction/parallax_map.h"
 #include "correction/remap_error.h"
 #include "correction/viewpoint_error.h"
+#include "model/atomic_write.h"
 #include "model/input_error.h"
 #include "tools/commands.h"
 #include "tools/plot.h"
@@ -54,7 +55,7 @@ void RunForMaps(const Options& options, const Context& context) {
     stats.push_back(RemapErrorAt(sensor, settings, ObjectAtDistance(settings.surface, HUGE_VAL), stride));
     progress.Advance();
   }
-  std::filesystem::create_directories(options.out_dir);
+  CreateOutputDirectory(options.out_dir);
   const std::filesystem::path dir(options.out_dir);
   WriteOutput((dir / "maps-error.csv").string(), [&](std::ostream& out) {
     out << "n,distance_mm,max_px,rms_px,samples\n" << std::setprecision(10);
@@ -99,7 +100,7 @@ void Run(const Options& options, const Context& context) {
   const Sensor sensor = LoadSensorYaml(options.sensor_path);
   const double rim = sensor.rim_radius_mm();
   const double distance = options.distance_mm ? *options.distance_mm : *options.n * rim;
-  std::filesystem::create_directories(options.out_dir);
+  CreateOutputDirectory(options.out_dir);
   const std::filesystem::path dir(options.out_dir);
 
   const std::vector<FieldSample> field = AnalyzeField(sensor, options.samples, distance);
@@ -158,9 +159,9 @@ Command ParallaxCommand() {
                                         "A directory from `omnical remap`: the table's error at other object distances (output px)");
             sub.add_option("--out", options->out_dir, "Output directory")->required();
             auto* n = sub.add_option("--n", options->n, "Object distance from the mirror, in mirror rim radii")
-                          ->check(CLI::PositiveNumber);
+                          ->check(kPositive);
             auto* d = sub.add_option("--distance-mm", options->distance_mm, "Object distance from the mirror, mm")
-                          ->check(CLI::PositiveNumber);
+                          ->check(kPositive);
             n->excludes(d);
             sub.add_option("--v0", options->v0_mm, "Viewpoint V0, z on the mirror axis (mm, mirror frame); "
                                                    "default: the one minimising the worst pixel error");

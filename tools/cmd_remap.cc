@@ -13,6 +13,7 @@
 
 #include "correction/map_export.h"
 #include "correction/remap_error.h"
+#include "model/atomic_write.h"
 #include "model/input_error.h"
 #include "tools/commands.h"
 #include "tools/plot.h"
@@ -85,7 +86,7 @@ void Run(const Options& options, const Context& context) {
   }
   const double exactness_px = ExactnessCheckPx(sensor, settings, table, 4000);
 
-  std::filesystem::create_directories(options.out_dir);
+  CreateOutputDirectory(options.out_dir);
   const std::filesystem::path dir(options.out_dir);
   nlohmann::json files = nlohmann::json::object();
   if (formats.count("opencv")) {

@@ -7,8 +7,6 @@
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <thread>
 
 #include "correction/renderer.h"
@@ -76,17 +74,19 @@ Command RenderCommand() {
             return [=, &context]() {
               const Scene scene = LoadSceneYaml(*scene_path);
               const Sensor& sensor = *scene.sensor;
-              std::filesystem::create_directories(*out_dir);
+              CreateOutputDirectory(*out_dir);
               const std::filesystem::path dir(*out_dir);
-              const std::string sensor_file = (dir / "sensor.yaml").string();
-              SaveSensorYaml(sensor, sensor_file);
-              std::stringstream sensor_yaml;
-              sensor_yaml << std::ifstream(sensor_file).rdbuf();
+              const std::string sensor_yaml = SensorYamlText(sensor);
               const auto start = std::chrono::steady_clock::now();
               const PixelRayGrid rays(sensor, *threads);
               nlohmann::json index;
               index["scene"] = std::filesystem::proximate(std::filesystem::absolute(*scene_path), std::filesystem::absolute(dir)).string();
               index["sensor_file"] = "sensor.yaml";
+              struct RenderedView {
+                std::vector<uchar> png;
+                std::string truth;
+              };
+              std::vector<RenderedView> rendered;
               for (size_t k = 0; k < scene.views.size(); ++k) {
                 const SceneView& view = scene.views[k];
                 cv::Mat image;
@@ -97,16 +97,23 @@ Command RenderCommand() {
                   image = RenderView(sensor, rays, view, scene.environment, scene.formation, static_cast<unsigned>(k),
                                      *threads, [&](long rows) { progress.Advance(rows); });
                 }
-                std::vector<uchar> png;
-                cv::imencode(".png", image, png, {cv::IMWRITE_PNG_COMPRESSION, 9});
-                WriteFileAtomically((dir / (view.name + ".png")).string(), [&](std::ostream& out) {
-                  out.write(reinterpret_cast<const char*>(png.data()), png.size());
-                });
-                const nlohmann::json truth = TruthJson(view, GroundTruth(sensor, view), *out_dir, sensor_yaml.str(), sensor);
-                WriteFileAtomically((dir / (view.name + ".json")).string(),
-                                    [&](std::ostream& out) { out << truth.dump(1) << '\n'; });
+                // Kept in memory and written together at the end: an interrupted render
+                // leaves the previous set whole, never new images beside old ground truth.
+                rendered.emplace_back();
+                cv::imencode(".png", image, rendered.back().png, {cv::IMWRITE_PNG_COMPRESSION, 9});
+                rendered.back().truth =
+                    TruthJson(view, GroundTruth(sensor, view), *out_dir, sensor_yaml, sensor).dump(1) + '\n';
                 index["views"].push_back({{"name", view.name}, {"image", view.name + ".png"}, {"truth", view.name + ".json"}});
               }
+              for (size_t k = 0; k < scene.views.size(); ++k) {
+                const std::vector<uchar>& png = rendered[k].png;
+                WriteFileAtomically((dir / (scene.views[k].name + ".png")).string(), [&](std::ostream& out) {
+                  out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+                });
+                WriteFileAtomically((dir / (scene.views[k].name + ".json")).string(),
+                                    [&](std::ostream& out) { out << rendered[k].truth; });
+              }
+              WriteFileAtomically((dir / "sensor.yaml").string(), [&](std::ostream& out) { out << sensor_yaml; });
               WriteFileAtomically((dir / "scene.json").string(), [&](std::ostream& out) { out << index.dump(2) << '\n'; });
               if (!context.quiet) {
                 const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -85,10 +85,10 @@ void Run(const Options& options, const Context& context) {
     return out;
   };
   const std::filesystem::path out_dir = std::filesystem::path(options.out).parent_path();
-  if (!out_dir.empty()) std::filesystem::create_directories(out_dir);
+  if (!out_dir.empty()) CreateOutputDirectory(out_dir);
 
   if (!IsVideo(options.input)) {
-    const cv::Mat image = cv::imread(options.input, cv::IMREAD_UNCHANGED);
+    const cv::Mat image = ReadImage(options.input, cv::IMREAD_UNCHANGED);
     if (image.empty()) throw InputError(InputMessage(options.input, "", "cannot be read as an image"));
     CheckFrameSize(image, sensor_width, sensor_height, options.input);
     if (IsVideo(options.out)) throw InputError(InputMessage(options.out, "", "an image input needs an image output"));

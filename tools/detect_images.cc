@@ -1,4 +1,5 @@
 #include "tools/detect_images.h"
+#include "tools/cli_common.h"
 
 #include <glob.h>
 
@@ -50,7 +51,7 @@ DetectedImages DetectImages(const CalibrationTarget& target, const std::string& 
     Progress progress("detect", static_cast<long>(paths.size()), options.quiet);
     auto work = [&]() {
       for (size_t i = next++; i < paths.size(); i = next++) {
-        const cv::Mat grey = cv::imread(paths[i], cv::IMREAD_GRAYSCALE);
+        const cv::Mat grey = ReadImage(paths[i], cv::IMREAD_GRAYSCALE);
         if (grey.empty()) {
           problems[i] = "cannot read the image";
         } else {

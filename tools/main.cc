@@ -3,16 +3,40 @@
 #include <CLI/CLI.hpp>
 #include <opencv2/core/utils/logger.hpp>
 
+#include <cmath>
+#include <cstdlib>
 #include <iostream>
 #include <map>
+#include <string>
+#include <vector>
 
+#include "model/atomic_write.h"
 #include "model/input_error.h"
 #include "tools/commands.h"
+
+namespace {
+
+// "1,nan,3" -> its parts (list options such as --elevation-deg take commas).
+std::vector<std::string> SplitOnCommas(const std::string& text) {
+  std::vector<std::string> parts(1);
+  for (char c : text) {
+    if (c == ',')
+      parts.emplace_back();
+    else
+      parts.back().push_back(c);
+  }
+  return parts;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   // Unreadable inputs get omnical's one-line errors; OpenCV's own warnings would add lines.
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
   using namespace omnical;
+  // Ctrl-C: the outputs are renamed into place only when complete; this removes the one
+  // being written, so an interrupted run leaves the previous results and nothing else.
+  RemoveTemporaryFilesOnInterrupt();
   CLI::App app{"omnical: calibration and correction of non-central catadioptric cameras"};
   app.require_subcommand(1);
   cli::Context context;
@@ -22,6 +46,21 @@ int main(int argc, char** argv) {
     CLI::App* sub = app.add_subcommand(command.name, command.summary);
     sub->fallthrough();  // -q/--quiet also after the subcommand
     actions[sub] = command.add(*sub, context);
+  }
+  // CLI11's number checks (PositiveNumber, Range) let NaN through (every comparison with
+  // NaN is false), and "1e400" parses as inf: no option of omnical takes a non-finite
+  // number, so any argument that reads as one is refused here.
+  for (int i = 1; i < argc; ++i) {
+    std::string value = argv[i];
+    if (value.rfind("--", 0) == 0 && value.find('=') != std::string::npos) value = value.substr(value.find('=') + 1);
+    for (const std::string& part : SplitOnCommas(value)) {
+      char* end = nullptr;
+      const double number = std::strtod(part.c_str(), &end);
+      if (!part.empty() && end == part.c_str() + part.size() && !std::isfinite(number)) {
+        std::cerr << "omnical: error: argument '" << argv[i] << "' is not a finite number (see --help)\n";
+        return 2;
+      }
+    }
   }
   try {
     app.parse(argc, argv);

@@ -1,4 +1,5 @@
 #include "tools/view_setup.h"
+#include "tools/cli_common.h"
 
 #include <algorithm>
 #include <cmath>
@@ -52,7 +53,7 @@ void AddViewOptions(CLI::App& sub, ViewOptions* options, bool required_view) {
       ->delimiter(',')->expected(3);
   sub.add_option("--v0", options->v0_mm, "Viewpoint V0, z on the mirror axis (mm, mirror frame); "
                                          "default: the one minimising the worst error at the distance");
-  sub.add_option("--threads", options->threads, "Threads (0: all cores)")->check(CLI::NonNegativeNumber);
+  sub.add_option("--threads", options->threads, "Threads (0: all cores)")->check(kNonNegative);
   sub.add_flag("--per-pixel", options->per_pixel,
                "Project every output pixel (no interpolated grid; its error bound is 0.01 px)");
   if (required_view) {

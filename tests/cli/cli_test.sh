@@ -261,6 +261,21 @@ if "$omnical" -q calibrate --target "$grid" --images "$rendered" --out "$work/ca
 else
   fail "calibrate from the rim circle exited $?"
 fi
+# Data that cannot determine what is asked: six views all 37-43 mirror radii away with the
+# sphere's radius free, and a solver cut to 10 iterations. The fit is written, with the
+# reasons on stderr and in calibration.json (issue 8).
+far=$source_dir/datasets-synthetic/rendered/ohte-sph-far
+if "$omnical" -q detect --target "$targets/aprilgrid-6x6-88mm.yaml" --images "$far" --out "$work/det_far.json" &&
+  "$omnical" -q calibrate --target "$targets/aprilgrid-6x6-88mm.yaml" --detections "$work/det_far.json" \
+    --sensor "$sensors/ohte-sph.yaml" --max-iterations 10 --out "$work/cal_far" 2>"$work/far.err"; then
+  for reason in "all targets are at one distance" "while the mirror shape is free" "A_mm is weakly determined" \
+    "did not converge"; do
+    grep -qF "$reason" "$work/far.err" && grep -qF "$reason" "$work/cal_far/calibration.json" && pass ||
+      fail "calibrate on one distance: no warning '$reason': $(cat "$work/far.err")"
+  done
+else
+  fail "calibrate on one distance exited $?"
+fi
 # --profile converts the guess (a sphere design fitted as a free polynomial mirror).
 "$omnical" -q calibrate --target "$grid" --detections "$work/det.json" --sensor "$guess" --profile polynomial --out "$work/cal_poly" 2>/dev/null &&
   grep -q "profile: polynomial" "$work/cal_poly/sensor.yaml" && near "$(json "$work/cal_poly/calibration.json" rms_px)" 0.15 0.15 "calibrate --profile polynomial RMS (px)" ||

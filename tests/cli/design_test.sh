@@ -72,7 +72,7 @@ check test -s "$work/edi-char/characteristics.csv"
 
 # Bad input: exit 2, one line naming the cause, nothing written.
 expect_error "Omega below Theta" "rim-omega" "$work/bad" -- design fit --profile sphere --rim-omega 10 --out "$work/bad"
-expect_error "NaN target" "rim-theta" "$work/bad" -- design fit --profile sphere --rim-theta nan --out "$work/bad"
+expect_error "NaN target" "argument 'nan' is not a finite number" "$work/bad" -- design fit --profile sphere --rim-theta nan --out "$work/bad"
 expect_error "sphere has no freedom" "a sphere is fixed by the two rim targets" "$work/bad" -- \
   design fit --profile sphere --characteristic equidistant --out "$work/bad"
 expect_error "lens inside the mirror" "lens at m = -" "$work/bad" -- \
