@@ -61,6 +61,12 @@ struct ReprojectionError {
   }
 };
 
+// The cost functor of a model type. Deduced from the Catadioptric's own template
+// arguments: clang (unlike GCC) treats Model::ProfileOf, an alias template, as a template
+// distinct from the profile itself (CWG 1286), and the functor's pointer type then mismatches.
+template <typename T, template <typename> class Profile, template <typename> class Lens>
+ReprojectionError<Profile, Lens> CostFor(const Catadioptric<T, Profile, Lens>*);
+
 std::vector<std::string> SplitNames(const char* info) {
   std::vector<std::string> names;
   std::stringstream stream(info);
@@ -94,7 +100,7 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
                    const std::vector<TargetPose>& initial_poses, const FitOptions& options) {
   using LensD = typename Model::LensType;
   using ProfileD = typename Model::ProfileType;
-  using Cost = ReprojectionError<Model::template ProfileOf, Model::template LensOf>;
+  using Cost = decltype(CostFor(static_cast<const Model*>(nullptr)));
   FitResult result;
 
   std::vector<double> lens(LensD::kNumParams);

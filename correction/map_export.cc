@@ -91,11 +91,27 @@ void WriteNpyMaps(const RemapTable& table, const std::string& x_path, const std:
   WriteNpyFloat32(table, table.map_y, y_path);
 }
 
+// The largest virtual screen side omnical writes (remap --size allows 2..20000).
+constexpr int kMaxMapSidePx = 20000;
+
 RemapTable ReadOpenCvMaps(const std::string& float_path) {
   cv::Mat map_x, map_y;
   try {
     cv::FileStorage fs(float_path, cv::FileStorage::READ);
     if (!fs.isOpened()) throw InputError(InputMessage(float_path, "", "cannot be read (missing or not an OpenCV storage file)"));
+    // The header is checked before OpenCV allocates rows x cols: a damaged "cols" made it
+    // ask for 32 GB (found by tests/fuzz).
+    for (const char* name : {"map_x", "map_y"}) {
+      const cv::FileNode node = fs[name];
+      if (node.empty()) throw InputError(InputMessage(float_path, name, "missing"));
+      if (!node.isMap() || !node["rows"].isInt() || !node["cols"].isInt() || !node["data"].isSeq())
+        throw InputError(InputMessage(float_path, name, "not an OpenCV matrix (rows, cols, dt, data)"));
+      const int rows = static_cast<int>(node["rows"]), cols = static_cast<int>(node["cols"]);
+      if (rows < 1 || cols < 1 || rows > kMaxMapSidePx || cols > kMaxMapSidePx)
+        throw InputError(InputMessage(float_path, name, "rows and cols must be 1.." + std::to_string(kMaxMapSidePx)));
+      if (node["data"].size() != static_cast<size_t>(rows) * static_cast<size_t>(cols))
+        throw InputError(InputMessage(float_path, name, "data does not hold rows x cols values"));
+    }
     fs["map_x"] >> map_x;
     fs["map_y"] >> map_y;
   } catch (const cv::Exception& e) {

@@ -315,5 +315,28 @@ TEST(MapExport, OpenCvMapsRoundTripAndNpyHeaderIsWellFormed) {
   EXPECT_THROW(ReadOpenCvMaps(dir + "/x.npy"), InputError);
 }
 
+// Regression (tests/fuzz, maps_yml): a damaged header made OpenCV allocate 32 GB before any
+// check. Each file must be refused with InputError naming the map, without allocating.
+TEST(MapExport, DamagedMapHeadersAreRefusedBeforeAllocating) {
+  const std::string dir = testing::PrivateTempDir();
+  const std::string matrix = "   dt: f\n   data: [ 1., 2., 3., 4. ]\n";
+  const std::string cases[] = {
+      // The fuzzer's input: a non-digit byte in front of cols.
+      "%YAML:1.0\n---\nmap_x: !!opencv-matrix\n   rows: 2\n   cols:\xff" "2\n" + matrix,
+      "%YAML:1.0\n---\nmap_x: !!opencv-matrix\n   rows: 2000000000\n   cols: 2000000000\n" + matrix,
+      "%YAML:1.0\n---\nmap_x: !!opencv-matrix\n   rows: 2\n   cols: 3\n" + matrix,  // 4 values, 6 promised
+      "%YAML:1.0\n---\nmap_x: 5\n",
+  };
+  for (const std::string& text : cases) {
+    std::ofstream(dir + "/damaged.yml") << text << "map_y: !!opencv-matrix\n   rows: 2\n   cols: 2\n" << matrix;
+    try {
+      ReadOpenCvMaps(dir + "/damaged.yml");
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find("map_x"), std::string::npos) << error.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace omnical
