@@ -116,6 +116,11 @@ RemapTable ReadOpenCvMaps(const std::string& float_path) {
     fs["map_y"] >> map_y;
   } catch (const cv::Exception& e) {
     throw InputError(InputMessage(float_path, "", std::string("cannot be parsed: ") + e.err));
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    // OpenCV's parser also lets std::length_error out of damaged YAML (found by tests/fuzz).
+    throw InputError(InputMessage(float_path, "", std::string("cannot be parsed: ") + e.what()));
   }
   if (map_x.empty() || map_y.empty()) throw InputError(InputMessage(float_path, "map_x/map_y", "missing"));
   if (map_x.type() != CV_32F || map_y.type() != CV_32F || map_x.size() != map_y.size())

@@ -336,6 +336,10 @@ TEST(MapExport, DamagedMapHeadersAreRefusedBeforeAllocating) {
       EXPECT_NE(std::string(error.what()).find("map_x"), std::string::npos) << error.what();
     }
   }
+  // The fuzzer's own reproducers, kept under tests/data/fuzz-crashes: the 32 GB header, and
+  // YAML on which OpenCV's parser throws std::length_error (it escaped as "internal error").
+  for (const char* name : {"maps_yml-32gb-alloc.yml", "maps_yml-length-error.yml"})
+    EXPECT_THROW(ReadOpenCvMaps(testing::SourceDir() + "/tests/data/fuzz-crashes/" + name), InputError) << name;
 }
 
 }  // namespace
