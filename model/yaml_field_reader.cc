@@ -10,11 +10,16 @@ namespace omnical {
 
 YAML::Node YamlFieldReader::LoadFile() const {
   if (!std::filesystem::exists(path_)) Fail("", "file not found");
+  // A directory opens as a stream and then throws std::ios_failure from inside yaml-cpp
+  // (found by tests/fuzz: a scene naming "sensor: ..").
+  if (std::filesystem::is_directory(path_)) Fail("", "is a directory, not a file");
   try {
     return YAML::LoadFile(path_);
   } catch (const YAML::ParserException& error) {
     Fail("line " + std::to_string(error.mark.line + 1), "malformed YAML: " + error.msg);
   } catch (const YAML::Exception& error) {
+    Fail("", std::string("cannot read: ") + error.what());
+  } catch (const std::exception& error) {
     Fail("", std::string("cannot read: ") + error.what());
   }
 }

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "calib/detections.h"
+#include "correction/scene.h"
 #include "model/input_error.h"
 #include "model/sensor.h"
 #include "test_sensors.h"
@@ -192,6 +194,22 @@ TEST(SensorYaml, MissingFileIsReported) {
   } catch (const InputError& error) {
     EXPECT_STREQ(error.what(), "/nonexistent/sensor.yaml: file not found");
   }
+}
+
+// Regression (tests/fuzz, scene_yaml): a scene naming a directory as its sensor ("sensor:
+// ..") let std::ios_failure out of yaml-cpp, "internal error" in the CLI. The fuzzer's
+// reproducer is kept in tests/data/fuzz-crashes; a directory given directly to the sensor
+// and detections readers is refused the same way.
+TEST(FuzzReproducers, ADirectoryWhereAFileBelongsIsRefused) {
+  const std::string crashes = testing::SourceDir() + "/tests/data/fuzz-crashes";
+  try {
+    LoadSceneYaml(crashes + "/scene_yaml-sensor-is-a-directory.yaml");
+    ADD_FAILURE() << "scene accepted";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("is a directory"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW(LoadSensorYaml(crashes), InputError);
+  EXPECT_THROW(ReadDetections(crashes), InputError);
 }
 
 }  // namespace

@@ -90,6 +90,8 @@ o=$work/out
 # project / unproject
 row project "missing sensor file" - error -- project --sensor "$f/none.yaml" --points "$f/points.csv"
 row project "empty sensor file" - error -- project --sensor "$f/empty.yaml" --points "$f/points.csv"
+row project "a directory as the sensor file" - error -- project --sensor "$f" --points "$f/points.csv"
+row project "a directory as the points file" "$o.csv" error -- project --sensor "$sensor" --points "$f" --out "$o.csv"
 row project "corrupt YAML" - error -- project --sensor "$f/corrupt.yaml" --points "$f/points.csv"
 row project "NaN focal length" - error -- project --sensor "$f/sensor-nan.yaml" --points "$f/points.csv"
 row project "infinite sphere radius" - error -- project --sensor "$f/sensor-inf.yaml" --points "$f/points.csv"
@@ -125,6 +127,9 @@ row detect "wrong target spec (type)" "$o.json" error -- detect --target "$f/tar
 row detect "empty image directory" "$o.json" error -- detect --target "$grid" --images "$f/no-images" --out "$o.json"
 row calibrate "one truncated image" "$o" error -- calibrate --target "$grid" --images "$f/truncated" --sensor "$guess" --out "$o"
 row calibrate "huge corner coordinate" "$o" error -- calibrate --target "$grid" --detections "$f/detections-huge.json" --sensor "$guess" --out "$o"
+row calibrate "a directory as the detections file" "$o" error -- calibrate --target "$grid" --detections "$f" --sensor "$guess" --out "$o"
+row detect "a directory as the target spec" "$o.json" error -- detect --target "$f" --images "$rendered" --out "$o.json"
+row "design ode" "a directory as the law table" "$o" error -- design ode --law table --law-table "$f" --focal-length-mm 12.5 --distance-mm 2000 --start-height-mm 155 --rim-limit-mm 30 --rho1-mm 2.4 --out "$o"
 row calibrate "empty detections file" "$o" error -- calibrate --target "$grid" --detections "$f/empty.csv" --sensor "$guess" --out "$o"
 row calibrate "negative tag size" "$o" error -- calibrate --target "$f/target-negative.yaml" --images "$rendered" --sensor "$guess" --out "$o"
 # remap / unwarp / export-central
