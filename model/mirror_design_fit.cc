@@ -183,6 +183,9 @@ std::string FitDesignSpec::Check() const {
     return "terms: a polynomial has 1 to 8 even terms";
   if (samples < 10 || samples > 100000) return "samples: must be in [10, 100000]";
   const int free = FreeParams(*this);
+  if (free == 0 && characteristic != ImageCharacteristic::kNone)
+    return std::string("characteristic: this ") + ProfileFamilyName(family) +
+           " is fixed by the two rim targets; nothing is left to shape for a characteristic";
   if (free > 0 && characteristic == ImageCharacteristic::kNone)
     return std::string("characteristic: a ") + ProfileFamilyName(family) + " keeps " + std::to_string(free) +
            " free parameter(s) after the rim targets; name the characteristic that fixes them";

@@ -115,6 +115,10 @@ TEST(DesignFit, TargetsOutsideTheFamilysReachAreRefused) {
   EXPECT_NE(message(spec).find("rim-theta"), std::string::npos) << message(spec);
   spec = Spec(ProfileFamily::kPolynomial, ImageCharacteristic::kNone);
   EXPECT_NE(message(spec).find("characteristic"), std::string::npos) << message(spec);
+  // One term (a parabola) is fixed by the rim targets: a characteristic is not silently ignored.
+  spec = Spec(ProfileFamily::kPolynomial, ImageCharacteristic::kEquidistant);
+  spec.polynomial_terms = 1;
+  EXPECT_NE(message(spec).find("nothing is left to shape"), std::string::npos) << message(spec);
   // A wide lens (Theta 60 deg) and a rim ray at 175 deg: the sphere must sit so close to
   // the lens (m = 0.03 radii) that the image of its centre turns back (x = 0.26).
   spec = Spec(ProfileFamily::kSphere, ImageCharacteristic::kNone);

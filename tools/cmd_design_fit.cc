@@ -99,7 +99,7 @@ void RunDesignFit(const DesignFitOptions& o, const Context& context) {
   spec.rim_theta_deg = o.rim_theta_deg;
   const std::string characteristic =
       !o.characteristic.empty() ? o.characteristic
-      : spec.family == ProfileFamily::kPolynomial ? "equidistant"
+      : spec.family == ProfileFamily::kPolynomial && o.terms > 1 ? "equidistant"
       : spec.family == ProfileFamily::kHyperboloid ? "svp"
                                                    : "";
   spec.characteristic = characteristic == "equidistant" ? ImageCharacteristic::kEquidistant
@@ -190,7 +190,10 @@ void RunDesignFit(const DesignFitOptions& o, const Context& context) {
   j["achieved_meaning"] =
       "measured through sensor.yaml's model (Eq. 4-7 per mirror radius, 1000 samples): max |h - h_law| in px with the rim at "
       "rim_h_px, for h_law through the origin and the rim point; viewpoint spread = max - min of Eq. 6's z_v";
-  if (compared) j["compared"] = CharacteristicsJson(*compared), j["compared"]["file"] = o.compare_path;
+  if (compared) {
+    j["compared"] = CharacteristicsJson(*compared);
+    j["compared"]["file"] = o.compare_path;
+  }
   j["solver"] = {{"free_parameters", design.free_params},
                  {"residuals", design.free_params > 0 ? spec.samples : 0},
                  {"iterations", design.iterations},
