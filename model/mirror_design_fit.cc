@@ -184,8 +184,10 @@ std::string FitDesignSpec::Check() const {
   if (samples < 10 || samples > 100000) return "samples: must be in [10, 100000]";
   const int free = FreeParams(*this);
   if (free == 0 && characteristic != ImageCharacteristic::kNone)
-    return std::string("characteristic: this ") + ProfileFamilyName(family) +
-           " is fixed by the two rim targets; nothing is left to shape for a characteristic";
+    return std::string("characteristic: a ") + ProfileFamilyName(family) +
+           (family == ProfileFamily::kPolynomial ? " of one term" : "") +
+           " is fixed by the two rim targets; nothing is left to shape for a characteristic (its laws are reported in "
+           "design.json anyway)";
   if (free > 0 && characteristic == ImageCharacteristic::kNone)
     return std::string("characteristic: a ") + ProfileFamilyName(family) + " keeps " + std::to_string(free) +
            " free parameter(s) after the rim targets; name the characteristic that fixes them";
@@ -294,9 +296,8 @@ CharacteristicReport MeasureCharacteristics(const Sensor& sensor, int samples) {
           if (!model.lens.ProjectToPixel(Vec3<double>(x, 0.0, model.pose.m_mm + q.z_mm), &pixel))
             throw InputError("characteristics: the lens cannot image the mirror point at x = " + std::to_string(x) + " mm");
           report.samples.push_back({x, q.omega_rad / kDegToRad, pixel.x() - cx, q.viewpoint_z_mm});
+          if (i == samples) report.rim_theta_deg = q.theta_rad / kDegToRad;
         }
-        const AxialRayQuantities rim = ComputeAxialRay(model, model.rim_radius_mm);
-        report.rim_theta_deg = rim.theta_rad / kDegToRad;
       },
       sensor.model());
   const CharacteristicSample& rim = report.samples.back();

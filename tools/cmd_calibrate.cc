@@ -320,9 +320,12 @@ void Run(const Options& options, const Context& context) {
   // the mirror under a small angle); fixing m from the design or fx from the lens helps.
   // Only scale-like parameters have a meaningful relative std (tilts, decenters, the
   // principal point and distortion are naturally near zero).
-  auto scale_like = [](const std::string& name) {
-    return name == "fx_px" || name == "fy_px" || name == "scale_px_per_mm" || name == "m_mm" || name == "A_mm" ||
-           name == "B_mm" || (name.size() >= 2 && name[0] == 'c' && std::isdigit(static_cast<unsigned char>(name[1])));
+  auto shape_parameter = [](const std::string& name) {
+    return name == "A_mm" || name == "B_mm" ||
+           (name.size() >= 2 && name[0] == 'c' && std::isdigit(static_cast<unsigned char>(name[1])));
+  };
+  auto scale_like = [&](const std::string& name) {
+    return name == "fx_px" || name == "fy_px" || name == "scale_px_per_mm" || name == "m_mm" || shape_parameter(name);
   };
   for (const ParameterEstimate& p : fit.parameters)
     if (!p.fixed && scale_like(p.name) && std::isfinite(p.std) && p.value != 0.0 && p.std > 0.05 * std::abs(p.value))
@@ -334,10 +337,8 @@ void Run(const Options& options, const Context& context) {
   // One distance: a non-central mirror's shape shows in how its image changes with the
   // object's distance (the viewpoints slide), so with every board at about the same range
   // the shape trades off against m and the lens scale.
-  const bool shape_free = std::any_of(fit.parameters.begin(), fit.parameters.end(), [](const ParameterEstimate& p) {
-    return !p.fixed && (p.name == "A_mm" || p.name == "B_mm" ||
-                        (p.name.size() >= 2 && p.name[0] == 'c' && std::isdigit(static_cast<unsigned char>(p.name[1]))));
-  });
+  const bool shape_free = std::any_of(fit.parameters.begin(), fit.parameters.end(),
+                                      [&](const ParameterEstimate& p) { return !p.fixed && shape_parameter(p.name); });
   double nearest_mm = HUGE_VAL, farthest_mm = 0.0;
   for (const TargetPose& pose : fit.poses) {
     nearest_mm = std::min(nearest_mm, pose.camera_from_target_translation_mm.norm());

@@ -69,12 +69,13 @@ void RunOde(const OdeOptions& options, const Context& context) {
   CreateOutputDirectory(dir);
   const double vertex_mm = design.profile.front().height_mm;
 
-  WriteFileAtomically((dir / "profile.csv").string(), [&](std::ostream& out) {
-    out << "# mirror profile from omnical design ode: radius x, sag z from the vertex, slope dz/dx (mm)\n"
-        << "x_mm,z_mm,dz_dx\n"
-        << std::setprecision(15);
-    for (const ProfileSample& s : design.profile) out << s.radius_mm << ',' << s.height_mm - vertex_mm << ',' << s.slope << '\n';
-  });
+  ProfileDrawing drawing;  // the profile from the vertex: profile.csv, the figures, the drawing
+  for (const ProfileSample& s : design.profile) {
+    drawing.radius_mm.push_back(s.radius_mm);
+    drawing.sag_mm.push_back(s.height_mm - vertex_mm);
+    drawing.slope.push_back(s.slope);
+  }
+  WriteProfileTable(drawing, "design ode", (dir / "profile.csv").string());
   const Sensor sensor = SensorFromOdeDesign(spec, design, options.image_size_px, (dir / "profile.csv").string());
   const double pitch_mm = PixelPitchMm(design, options.image_size_px);
   const auto& lens = std::get<Catadioptric<double, TabulatedProfile, PinholeLens>>(sensor.model()).lens;
@@ -143,9 +144,7 @@ void RunOde(const OdeOptions& options, const Context& context) {
   }
   PlotPanel profile("Mirror profile", "x (mm)", "sag z (mm)");
   profile.equal_aspect = true;
-  std::vector<double> x, z;
-  for (const ProfileSample& s : design.profile) x.push_back(s.radius_mm), z.push_back(s.height_mm - vertex_mm);
-  profile.series.emplace_back("profile", x, z, SeriesColor(0));
+  profile.series.emplace_back("profile", drawing.radius_mm, drawing.sag_mm, SeriesColor(0));
   PlotPanel rays("Rays: image -> pinhole -> mirror -> reference cylinder", "radius (mm)", "height above the image plane (mm)");
   for (int i = 0; i <= 12; ++i) {
     const double rho = spec.rho0_mm + (design.rho_end_mm - spec.rho0_mm) * i / 12.0;
@@ -159,16 +158,10 @@ void RunOde(const OdeOptions& options, const Context& context) {
                              std::vector<double>{0.0, spec.focal_length_mm, it->height_mm, h}, cv::Scalar(160, 160, 160));
     rays.series.back().thickness = 1;
   }
-  rays.series.emplace_back("mirror", x, std::vector<double>(), SeriesColor(1));
+  rays.series.emplace_back("mirror", drawing.radius_mm, std::vector<double>(), SeriesColor(1));
   for (const ProfileSample& s : design.profile) rays.series.back().y.push_back(s.height_mm);
   WritePng((dir / "law_ratio.png").string(), RenderPanel(ratio, 900, 500));
   WritePng((dir / "profile.png").string(), TilePanels({RenderPanel(profile, 700, 450), RenderPanel(rays, 700, 450)}, 2));
-  ProfileDrawing drawing;
-  for (const ProfileSample& s : design.profile) {
-    drawing.radius_mm.push_back(s.radius_mm);
-    drawing.sag_mm.push_back(s.height_mm - vertex_mm);
-    drawing.slope.push_back(s.slope);
-  }
   const char* law_name = spec.law.kind == ImagingLaw::Kind::kLinear     ? "linear"
                          : spec.law.kind == ImagingLaw::Kind::kLogPolar ? "log-polar"
                                                                         : "tabulated";

@@ -102,14 +102,9 @@ void RunDesignFit(const DesignFitOptions& o, const Context& context) {
       : spec.family == ProfileFamily::kPolynomial && o.terms > 1 ? "equidistant"
       : spec.family == ProfileFamily::kHyperboloid ? "svp"
                                                    : "";
-  spec.characteristic = characteristic == "equidistant" ? ImageCharacteristic::kEquidistant
-                        : characteristic == "svp"       ? ImageCharacteristic::kSingleViewpoint
-                        : characteristic == "aspect"    ? ImageCharacteristic::kConstantAspect
-                        : characteristic == "area"      ? ImageCharacteristic::kEqualArea
-                                                        : ImageCharacteristic::kNone;
-  if (spec.family == ProfileFamily::kSphere && spec.characteristic != ImageCharacteristic::kNone)
-    throw InputError("design fit: --characteristic: a sphere is fixed by the two rim targets (A and m); nothing is left to "
-                     "shape it for " + characteristic + " (its laws are reported in design.json anyway)");
+  for (ImageCharacteristic c : {ImageCharacteristic::kEquidistant, ImageCharacteristic::kSingleViewpoint,
+                                 ImageCharacteristic::kConstantAspect, ImageCharacteristic::kEqualArea})
+    if (characteristic == CharacteristicName(c)) spec.characteristic = c;
   // The comparison sensor is read before anything is written, so a bad file leaves no output.
   std::optional<CharacteristicReport> compared;
   constexpr int kSamples = 1000;
@@ -142,13 +137,7 @@ void RunDesignFit(const DesignFitOptions& o, const Context& context) {
         }
       },
       sensor.model());
-  WriteFileAtomically((dir / "profile.csv").string(), [&](std::ostream& out) {
-    out << "# mirror profile from omnical design fit: radius x, sag z from the vertex, slope dz/dx (mm)\n"
-        << "x_mm,z_mm,dz_dx\n"
-        << std::setprecision(15);
-    for (size_t i = 0; i < drawing.radius_mm.size(); ++i)
-      out << drawing.radius_mm[i] << ',' << drawing.sag_mm[i] << ',' << drawing.slope[i] << '\n';
-  });
+  WriteProfileTable(drawing, "design fit", (dir / "profile.csv").string());
   char lens_note[160];
   std::snprintf(lens_note, sizeof lens_note, "Lens principal point on the axis %.3f mm below the vertex (m).",
                 design.m * o.rim_radius_mm);

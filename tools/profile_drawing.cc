@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iomanip>
 
 #include "model/atomic_write.h"
 #include "model/input_error.h"
@@ -46,18 +47,22 @@ struct Layout {
   }
 };
 
+// The sample interval [i, i + 1] holding radius r.
+size_t IntervalOf(const ProfileDrawing& d, double r) {
+  const auto upper = std::upper_bound(d.radius_mm.begin(), d.radius_mm.end(), r);
+  return std::clamp<size_t>(upper - d.radius_mm.begin(), 1, d.radius_mm.size() - 1) - 1;
+}
+
 // Cubic Hermite through the samples (value and slope), so stations between samples keep
 // the design's accuracy.
 double SagAt(const ProfileDrawing& d, double r) {
-  const auto upper = std::upper_bound(d.radius_mm.begin(), d.radius_mm.end(), r);
-  const size_t i = std::clamp<size_t>(upper - d.radius_mm.begin(), 1, d.radius_mm.size() - 1) - 1;
+  const size_t i = IntervalOf(d, r);
   const double h = d.radius_mm[i + 1] - d.radius_mm[i], t = (r - d.radius_mm[i]) / h;
   const double h00 = (1 + 2 * t) * (1 - t) * (1 - t), h10 = t * (1 - t) * (1 - t), h01 = t * t * (3 - 2 * t), h11 = t * t * (t - 1);
   return h00 * d.sag_mm[i] + h10 * h * d.slope[i] + h01 * d.sag_mm[i + 1] + h11 * h * d.slope[i + 1];
 }
 double SlopeAt(const ProfileDrawing& d, double r) {
-  const auto upper = std::upper_bound(d.radius_mm.begin(), d.radius_mm.end(), r);
-  const size_t i = std::clamp<size_t>(upper - d.radius_mm.begin(), 1, d.radius_mm.size() - 1) - 1;
+  const size_t i = IntervalOf(d, r);
   const double t = (r - d.radius_mm[i]) / (d.radius_mm[i + 1] - d.radius_mm[i]);
   return (1 - t) * d.slope[i] + t * d.slope[i + 1];
 }
@@ -191,6 +196,16 @@ cv::Mat RenderPng(const Layout& layout) {
 }
 
 }  // namespace
+
+void WriteProfileTable(const ProfileDrawing& drawing, const std::string& source, const std::string& path) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "# mirror profile from omnical " << source << ": radius x, sag z from the vertex, slope dz/dx (mm)\n"
+        << "x_mm,z_mm,dz_dx\n"
+        << std::setprecision(15);
+    for (size_t i = 0; i < drawing.radius_mm.size(); ++i)
+      out << drawing.radius_mm[i] << ',' << drawing.sag_mm[i] << ',' << drawing.slope[i] << '\n';
+  });
+}
 
 void WriteProfileDrawing(const ProfileDrawing& drawing, const std::string& svg_path, const std::string& png_path) {
   const Layout layout = MakeLayout(drawing);

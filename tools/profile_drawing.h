@@ -18,6 +18,10 @@ struct ProfileDrawing {
   int stations = 16;               // ordinate rows, evenly spaced in radius, rim included
 };
 
+// The profile table a tabulated mirror reads (x_mm, z_mm, dz_dx; see README "Sensor
+// file"), from the drawing's samples; `source` names the subcommand in its comment line.
+void WriteProfileTable(const ProfileDrawing& drawing, const std::string& source, const std::string& path);
+
 // Throws InputError naming the path when a file cannot be written.
 void WriteProfileDrawing(const ProfileDrawing& drawing, const std::string& svg_path, const std::string& png_path);
 
