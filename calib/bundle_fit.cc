@@ -79,9 +79,9 @@ std::vector<std::string> SplitNames(const char* info) {
 }
 
 // Calls add(name, block, index, unit scale) for every sensor parameter, in a fixed order.
-template <typename LensD, typename ProfileD, typename Add>
-void ForEachParameter(const double* lens, const double* m_mm, const double* tilt, const double* decenter,
-                      const double* shape, int shape_count, const Add& add) {
+template <typename LensD, typename ProfileD, typename Pointer, typename Add>
+void ForEachParameter(Pointer lens, Pointer m_mm, Pointer tilt, Pointer decenter, Pointer shape, int shape_count,
+                      const Add& add) {
   const std::vector<std::string> lens_names = SplitNames(LensD::kParamsInfo);
   for (int k = 0; k < LensD::kNumParams; ++k) add(lens_names[k], lens, k, 1.0);
   add("m_mm", m_mm, 0, 1.0);
@@ -95,6 +95,70 @@ void ForEachParameter(const double* lens, const double* m_mm, const double* tilt
   }
 }
 
+// The model with its blocks set from the fit's arrays.
+template <typename Model>
+Model WithBlocks(Model model, const double* lens, double m_mm, const double* tilt, const double* decenter,
+                 const double* shape, int shape_count) {
+  using ProfileD = typename Model::ProfileType;
+  model.lens = Model::LensType::FromParams(lens);
+  model.pose = MirrorPose<double>{m_mm, tilt[0], tilt[1], decenter[0], decenter[1]};
+  if constexpr (kPolynomial<ProfileD>) {
+    model.mirror = ProfileD::FromParams(shape, shape_count);
+  } else if constexpr (!kTabulated<ProfileD>) {
+    model.mirror = ProfileD::FromParams(shape);
+  }
+  return model;
+}
+
+// A design tolerance as a residual: noise_px x (x - design) / tolerance. Scaled by the
+// corner noise so that, next to residuals in px, it weighs as a Gaussian prior of that
+// standard deviation would: with J_prior = noise / tolerance, J^T J / noise^2 gains
+// 1 / tolerance^2. The noise is the fit's current estimate (updated between solves).
+class PriorCost : public ceres::CostFunction {
+ public:
+  PriorCost(int block_size, int index, double design, double tolerance, const double* noise_px)
+      : index_(index), design_(design), tolerance_(tolerance), noise_px_(noise_px) {
+    set_num_residuals(1);
+    mutable_parameter_block_sizes()->push_back(block_size);
+  }
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    const double weight = *noise_px_ / tolerance_;
+    residuals[0] = weight * (parameters[0][index_] - design_);
+    if (jacobians && jacobians[0]) {
+      std::fill(jacobians[0], jacobians[0] + parameter_block_sizes()[0], 0.0);
+      jacobians[0][index_] = weight;
+    }
+    return true;
+  }
+
+ private:
+  int index_;
+  double design_, tolerance_;
+  const double* noise_px_;
+};
+
+// The parameter names a tolerance key stands for (a pair for the two-component ones).
+std::vector<std::string> ToleranceTargets(const std::string& key) {
+  if (key == "tilt_deg") return {"tilt_x_deg", "tilt_y_deg"};
+  if (key == "decenter_mm") return {"decenter_x_mm", "decenter_y_mm"};
+  if (key == "principal_point_px") return {"cx_px", "cy_px"};
+  if (key == "focal_px") return {"fx_px", "fy_px"};
+  return {key};
+}
+
+std::string FormatNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+std::string FormatPx(double value) { return FormatNumber(value) + " px"; }
+
+// A parameter this many tolerances from its design is reported (3: a 0.3 % event).
+constexpr double kToleranceConflict = 3.0;
+
+// A view's corners fewer than this leave its pose (6 unknowns) barely determined.
+constexpr size_t kMinCornersPerView = 4;
+
 template <typename Model>
 FitResult FitModel(const Model& guess, const CalibrationTarget& target, const DetectionSet& detections,
                    const std::vector<TargetPose>& initial_poses, const FitOptions& options) {
@@ -102,6 +166,7 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
   using ProfileD = typename Model::ProfileType;
   using Cost = decltype(CostFor(static_cast<const Model*>(nullptr)));
   FitResult result;
+  result.guess_rim_radius_mm = guess.rim_radius_mm;
 
   std::vector<double> lens(LensD::kNumParams);
   guess.lens.ToParams(lens.data());
@@ -149,6 +214,9 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
   };
   std::vector<Residual> residuals;
   result.residuals_px.resize(views);
+  result.view_left_out.assign(views, "");
+  result.per_view_outliers.assign(views, 0);
+  std::vector<size_t> view_residuals(views, 0);
   for (size_t v = 0; v < views; ++v) {
     const ImageDetections& image = detections.images[v];
     result.residuals_px[v].assign(image.corners.size(), Eigen::Vector2d::Constant(NAN));
@@ -180,14 +248,57 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
       cost->SetNumResiduals(2);
       const ceres::ResidualBlockId id = problem.AddResidualBlock(cost, loss.get(), blocks);
       residuals.push_back({v, i, std::make_unique<Cost>(cost_template), blocks, id});
+      ++view_residuals[v];
     }
   }
-  if (residuals.empty()) {
+  // A view is fitted whole or not at all: a pose resting on a few corners is a free gauge
+  // that makes every reported std undetermined.
+  auto leave_out = [&](size_t v, const std::string& why) {
+    result.view_left_out[v] = why;
+    for (Residual& r : residuals)
+      if (r.view == v) r.outlier = true;
+    if (problem.HasParameterBlock(rotations[v].data())) problem.RemoveParameterBlock(rotations[v].data());
+    if (problem.HasParameterBlock(translations[v].data())) problem.RemoveParameterBlock(translations[v].data());
+  };
+  for (size_t v = 0; v < views; ++v)
+    if (view_residuals[v] < kMinCornersPerView)
+      leave_out(v, std::to_string(view_residuals[v]) + " of " + std::to_string(detections.images[v].corners.size()) +
+                       " corners project through the guess");
+  if (std::none_of(residuals.begin(), residuals.end(), [](const Residual& r) { return !r.outlier; })) {
     result.solver_report = "no observation could be projected through the initial guess";
     return result;
   }
   for (size_t v = 0; v < views; ++v)
     if (problem.HasParameterBlock(rotations[v].data())) problem.SetManifold(rotations[v].data(), new ceres::EigenQuaternionManifold);
+
+  // Design tolerances as prior residuals on the sensor's own blocks.
+  struct Prior {
+    std::string name;
+    double* block;
+    int index;
+    double design, tolerance;  // internal units
+    double scale;              // internal -> reported units
+  };
+  std::map<std::string, std::pair<double*, std::pair<int, double>>> named;  // name -> block, index, unit scale
+  ForEachParameter<LensD, ProfileD>(lens.data(), &m_mm, tilt, decenter, shape.data(), shape_count,
+                                    [&](const std::string& name, double* block, int index, double scale) {
+                                      named[name] = {block, {index, scale}};
+                                    });
+  const std::map<const double*, int> block_sizes = {{lens.data(), static_cast<int>(lens.size())}, {&m_mm, 1}, {tilt, 2},
+                                                    {decenter, 2}, {shape.data(), static_cast<int>(shape.size())}};
+  double prior_noise_px = 1.0;  // the corner noise the priors are scaled by; updated below
+  std::vector<Prior> priors;
+  for (const auto& [key, tolerance] : options.tolerances)
+    for (const std::string& name : ToleranceTargets(key)) {
+      const auto found = named.find(name);
+      if (found == named.end()) continue;  // CheckFor names it; unreachable for checked options
+      double* block = found->second.first;
+      const auto [index, scale] = found->second.second;
+      priors.push_back({name, block, index, block[index], tolerance / scale, scale});
+      problem.AddResidualBlock(new PriorCost(block_sizes.at(block), index, block[index], tolerance / scale, &prior_noise_px),
+                               nullptr, block);
+    }
+
   // Which lens entries are held: all, the scale (fx, fy or the orthographic scale), and in
   // stage 1 the radial distortion (k1, k2), which otherwise absorbs the error of a poor
   // start and leads into a local minimum.
@@ -235,6 +346,23 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
       }
     }
   };
+  // |residual| of every fitted corner at the current parameters (NaN if it cannot project).
+  auto residual_norms = [&]() {
+    std::vector<double> norms(residuals.size(), NAN);
+    for (size_t k = 0; k < residuals.size(); ++k) {
+      double value[2];
+      if (!residuals[k].outlier && (*residuals[k].functor)(residuals[k].blocks.data(), value))
+        norms[k] = std::hypot(value[0], value[1]);
+    }
+    return norms;
+  };
+  // A robust sigma per coordinate: |e| of a 2-D Gaussian has median 1.1774 sigma.
+  auto robust_sigma = [&](std::vector<double> norms) {
+    norms.erase(std::remove_if(norms.begin(), norms.end(), [](double n) { return !std::isfinite(n); }), norms.end());
+    if (norms.empty()) return 1.0;
+    std::nth_element(norms.begin(), norms.begin() + norms.size() / 2, norms.end());
+    return norms[norms.size() / 2] / 1.1774;
+  };
 
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;
@@ -252,45 +380,111 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
     set_poses(true);
     ceres::Solve(solver, &problem, &summary);
   }
-  // Stage 1: everything but the distortion; stage 2: everything asked for.
+  // Stage 1: everything but the distortion; stage 2: everything asked for. The priors
+  // weigh against the residuals left by the stage before (while the start is poor they are
+  // large and so hold the sensor near its design: a continuation away from wrong basins).
+  prior_noise_px = std::max(1e-3, robust_sigma(residual_norms()));
   set_poses(true);
   set_sensor(true);
   if (!distortion.empty()) {
     set_lens(true);
     ceres::Solve(solver, &problem, &summary);
+    prior_noise_px = std::max(1e-3, robust_sigma(residual_norms()));
   }
   set_lens(false);
   ceres::Solve(solver, &problem, &summary);
-  // Gross outliers (robust mode): residuals beyond 5 sigma, with sigma from the median
-  // residual (a 2-D Gaussian's |e| has median 1.1774 sigma; P(|e| > 5 sigma) = 4e-6), are
-  // removed and the fit repeated without them, under Huber.
+  // Gross outliers (robust mode): beyond max(floor, k sigma) of a robust sigma, removed and
+  // the fit repeated without them, under Huber. A view left with too few corners goes.
   if (options.robust_loss_px > 0.0) {
-    std::vector<double> norms;
-    for (const Residual& r : residuals) {
-      double value[2];
-      if ((*r.functor)(r.blocks.data(), value)) norms.push_back(std::hypot(value[0], value[1]));
+    const std::vector<double> norms = residual_norms();
+    const double threshold = std::max(options.outlier_floor_px, options.outlier_sigmas * robust_sigma(norms));
+    result.outlier_threshold_px = threshold;
+    std::vector<size_t> view_inliers(views, 0);
+    for (size_t k = 0; k < residuals.size(); ++k) {
+      Residual& r = residuals[k];
+      if (r.outlier) continue;
+      if (!(norms[k] <= threshold)) {
+        r.outlier = true;
+        ++result.outliers;
+        ++result.per_view_outliers[r.view];
+        problem.RemoveResidualBlock(r.id);
+      } else {
+        ++view_inliers[r.view];
+      }
     }
-    if (!norms.empty()) {
-      std::nth_element(norms.begin(), norms.begin() + norms.size() / 2, norms.end());
-      const double threshold = 5.0 * norms[norms.size() / 2] / 1.1774;
-      for (Residual& r : residuals) {
-        double value[2];
-        if (!(*r.functor)(r.blocks.data(), value) || std::hypot(value[0], value[1]) > threshold) {
-          r.outlier = true;
-          ++result.outliers;
-          problem.RemoveResidualBlock(r.id);
-        }
+    for (size_t v = 0; v < views; ++v)
+      if (result.view_left_out[v].empty() && view_inliers[v] < kMinCornersPerView)
+        leave_out(v, std::to_string(result.per_view_outliers[v]) + " of " + std::to_string(view_residuals[v]) +
+                         " corners rejected as outliers (beyond " + FormatPx(threshold) + ")");
+    // A view that fits as a whole far worse than the others shows something else than
+    // their board (a false or a bent board, a wrong size): its corners are not outliers one
+    // by one, but together they pull the sensor.
+    std::vector<double> view_square(views, 0.0), view_rms;
+    for (size_t k = 0; k < residuals.size(); ++k)
+      if (!residuals[k].outlier && std::isfinite(norms[k])) view_square[residuals[k].view] += norms[k] * norms[k];
+    for (size_t v = 0; v < views; ++v)
+      if (result.view_left_out[v].empty()) view_rms.push_back(std::sqrt(view_square[v] / view_inliers[v]));
+    if (view_rms.size() >= 3) {
+      std::vector<double> sorted = view_rms;
+      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+      const double median_rms = sorted[sorted.size() / 2];
+      const double limit = std::max(options.outlier_floor_px, options.view_rms_ratio * median_rms);
+      for (size_t v = 0, k = 0; v < views; ++v) {
+        if (!result.view_left_out[v].empty()) continue;
+        const double rms = view_rms[k++];
+        if (rms > limit)
+          leave_out(v, "its corners fit at " + FormatPx(rms) + " RMS, beyond " + FormatPx(limit) + " (" +
+                           FormatNumber(options.view_rms_ratio) + " x the views' median " + FormatPx(median_rms) +
+                           "): not the board the other views show (a false, bent or wrongly sized board)");
       }
     }
     loss->Reset(new ceres::HuberLoss(options.robust_loss_px), ceres::TAKE_OWNERSHIP);
+    prior_noise_px = std::max(1e-3, robust_sigma(residual_norms()));
     ceres::Solve(solver, &problem, &summary);
+  }
+
+  // Plain residuals at the solution; the statistics are over the inliers.
+  int inliers = 0;
+  double sum = 0.0;
+  int free_columns = 0;
+  std::vector<double*> variable;
+  auto statistics = [&]() {
+    sum = 0.0;
+    inliers = 0;
+    for (const Residual& r : residuals) {
+      double value[2];
+      if (r.outlier || !(*r.functor)(r.blocks.data(), value)) continue;
+      sum += value[0] * value[0] + value[1] * value[1];
+      ++inliers;
+    }
+    std::vector<double*> all;
+    problem.GetParameterBlocks(&all);
+    variable.clear();
+    free_columns = 0;
+    for (double* b : all)
+      if (!problem.IsParameterBlockConstant(b)) variable.push_back(b), free_columns += problem.ParameterBlockTangentSize(b);
+    // The covariance's scale: sigma per coordinate with the fit's degrees of freedom.
+    return std::sqrt(sum / std::max(1, 2 * inliers - free_columns));
+  };
+  result.sigma_px = statistics();
+  // The priors' final weight: the noise the covariance is scaled by (so the two agree).
+  if (!priors.empty() && std::abs(result.sigma_px - prior_noise_px) > 0.05 * prior_noise_px) {
+    prior_noise_px = std::max(1e-6, result.sigma_px);
+    ceres::Solve(solver, &problem, &summary);
+    result.sigma_px = statistics();
   }
   result.converged = summary.termination_type == ceres::CONVERGENCE;
   result.solver_report = summary.BriefReport();
-
-  // Plain residuals at the solution; the statistics are over the inliers.
-  double sum = 0.0;
-  int inliers = 0;
+  // A parameter that ends many tolerances from its design: the guess, the tolerance or the
+  // data is wrong (a prior that strong against the data is no longer a weak one).
+  for (const Prior& prior : priors) {
+    const double moved = std::abs(prior.block[prior.index] - prior.design) / prior.tolerance;
+    if (moved > kToleranceConflict)
+      result.tolerance_conflicts.push_back(prior.name + " ended " + FormatNumber(moved) + " tolerances (" +
+                                           FormatNumber(prior.tolerance * prior.scale) + ") from its design value " +
+                                           FormatNumber(prior.design * prior.scale) +
+                                           ": the guess, its tolerance or the data is off");
+  }
   std::vector<double> view_sum(views, 0.0);
   std::vector<int> view_count(views, 0);
   for (const Residual& r : residuals) {
@@ -299,8 +493,6 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
     const Eigen::Vector2d e(value[0], value[1]);
     result.residuals_px[r.view][r.index] = e;
     if (r.outlier) continue;
-    sum += e.squaredNorm();
-    ++inliers;
     view_sum[r.view] += e.squaredNorm();
     ++view_count[r.view];
   }
@@ -308,67 +500,79 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
   for (size_t v = 0; v < views; ++v)
     result.per_view_rms_px.push_back(view_count[v] ? std::sqrt(view_sum[v] / view_count[v]) : NAN);
 
-  // Standard deviations: (J^T J)^-1 at the solution, scaled by the residual variance
-  // (the fit does not know the detection noise). The Jacobian's columns differ by many
-  // orders of magnitude (a polynomial's c3 multiplies r^6), so they are scaled to unit
-  // norm before the inversion: ceres::Covariance's truncated SVD would otherwise discard
-  // well-determined directions and report their variance as zero.
-  std::map<const double*, Eigen::VectorXd> variances;  // per free sensor block, ambient order
+  // Covariance: (J^T J)^-1 at the solution, J the corner residuals over sigma with the
+  // priors' rows 1 / tolerance beneath (the posterior of a Gaussian prior). The Jacobian's
+  // columns differ by many orders of magnitude (a polynomial's c3 multiplies r^6), so they
+  // are scaled to unit norm before the SVD: a truncated decomposition would otherwise
+  // discard well-determined directions and report their variance as zero. The poses are
+  // in it: the sensor's block of the inverse is its covariance with the poses marginalised.
+  std::map<const double*, std::vector<int>> columns;  // free block -> column of each ambient entry, -1 if held
+  {
+    int column = 0;
+    for (double* b : variable) {
+      const int tangent = problem.ParameterBlockTangentSize(b), size = problem.ParameterBlockSize(b);
+      std::vector<int> map(size, -1);
+      if (b == lens.data() && tangent < size) {  // held entries of the lens: the free ones in order
+        int t = 0;
+        for (int k = 0; k < size; ++k)
+          if (std::find(held_scale.begin(), held_scale.end(), k) == held_scale.end()) map[k] = column + t++;
+      } else if (tangent == size) {
+        for (int k = 0; k < size; ++k) map[k] = column + k;
+      }
+      columns[b] = map;
+      column += tangent;
+    }
+  }
+  Eigen::MatrixXd covariance_internal;
   if (options.compute_covariance) {
-    std::vector<double*> variable;
-    std::vector<double*> all;
-    problem.GetParameterBlocks(&all);
-    for (double* b : all)
-      if (!problem.IsParameterBlockConstant(b)) variable.push_back(b);
+    std::vector<ceres::ResidualBlockId> data_blocks;
+    for (const Residual& r : residuals)
+      if (!r.outlier) data_blocks.push_back(r.id);
     ceres::Problem::EvaluateOptions evaluate;
     evaluate.parameter_blocks = variable;
+    evaluate.residual_blocks = data_blocks;
     evaluate.apply_loss_function = false;
     ceres::CRSMatrix crs;
     problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
-    Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+    std::vector<std::pair<int, double>> prior_rows;  // column, 1 / tolerance
+    for (const Prior& prior : priors) {
+      const auto found = columns.find(prior.block);
+      if (found != columns.end() && found->second[prior.index] >= 0)
+        prior_rows.push_back({found->second[prior.index], 1.0 / prior.tolerance});
+    }
+    Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows + prior_rows.size(), crs.num_cols);
+    const double inverse_sigma = 1.0 / std::max(result.sigma_px, 1e-12);
     for (int r = 0; r < crs.num_rows; ++r)
-      for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) jacobian(r, crs.cols[k]) = crs.values[k];
+      for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) jacobian(r, crs.cols[k]) = crs.values[k] * inverse_sigma;
+    for (size_t p = 0; p < prior_rows.size(); ++p) jacobian(crs.num_rows + p, prior_rows[p].first) = prior_rows[p].second;
     Eigen::VectorXd column_scale = jacobian.colwise().norm().transpose();
-    const bool all_seen = (column_scale.array() > 0.0).all();
-    if (all_seen) {
+    if ((column_scale.array() > 0.0).all() && jacobian.rows() >= jacobian.cols()) {
       const Eigen::MatrixXd scaled = jacobian * column_scale.cwiseInverse().asDiagonal();
       const Eigen::JacobiSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeThinV);
-      const Eigen::VectorXd& sigma = svd.singularValues();
+      const Eigen::VectorXd& singular = svd.singularValues();
       // Rank check on the scaled problem: a real degeneracy (a gauge left free) shows here.
-      if (sigma.minCoeff() > 1e-10 * sigma.maxCoeff()) {
+      if (singular.minCoeff() > 1e-10 * singular.maxCoeff()) {
         result.covariance_ok = true;
-        const Eigen::MatrixXd v = svd.matrixV() * sigma.cwiseInverse().asDiagonal();
-        const Eigen::VectorXd scaled_variance = v.rowwise().squaredNorm();
-        const double residual_variance = sum / std::max(1, 2 * inliers - crs.num_cols);
-        int column = 0;
-        for (double* b : variable) {
-          const int tangent = problem.ParameterBlockTangentSize(b), size = problem.ParameterBlockSize(b);
-          Eigen::VectorXd block = Eigen::VectorXd::Zero(size);
-          // Tangent coordinates: all of the block, or (lens with held scale) the free entries in order.
-          std::vector<int> free;
-          for (int k = 0; k < size; ++k) free.push_back(k);
-          if (b == lens.data() && tangent < size) {
-            free.clear();
-            for (int k = 0; k < size; ++k)
-              if (std::find(held_scale.begin(), held_scale.end(), k) == held_scale.end()) free.push_back(k);
-          }
-          if (static_cast<int>(free.size()) == tangent) {
-            for (int t = 0; t < tangent; ++t)
-              block(free[t]) = scaled_variance(column + t) / (column_scale(column + t) * column_scale(column + t)) * residual_variance;
-            variances[b] = block;
-          }
-          column += tangent;
-        }
+        const Eigen::MatrixXd v = column_scale.cwiseInverse().asDiagonal() * svd.matrixV() * singular.cwiseInverse().asDiagonal();
+        covariance_internal = v * v.transpose();
       }
     }
   }
+  // The covariance of the sensor's free parameters in reported units, and each std.
+  std::vector<std::pair<int, double>> covariance_rows;  // column, unit scale
   auto add = [&](const std::string& name, const double* block, int index, double scale) {
     ParameterEstimate estimate;
     estimate.name = name;
     estimate.value = block[index] * scale;
     estimate.fixed = problem.IsParameterBlockConstant(const_cast<double*>(block));  // after stage 2: as asked
-    const auto found = variances.find(block);
-    if (found != variances.end()) estimate.std = std::sqrt(std::max(0.0, found->second(index))) * scale;
+    const auto found = columns.find(block);
+    const int column = found == columns.end() ? -1 : found->second[index];
+    if (column < 0) estimate.fixed = true;
+    if (result.covariance_ok && column >= 0) {
+      estimate.std = std::sqrt(std::max(0.0, covariance_internal(column, column))) * scale;
+      covariance_rows.push_back({column, scale});
+      result.covariance_names.push_back(name);
+    }
     if (!estimate.fixed && !result.covariance_ok) estimate.std = NAN;  // undetermined: say so
     result.parameters.push_back(estimate);
   };
@@ -377,14 +581,35 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
     for (size_t k = 0; k < (LensD::kIsOrthographic ? 1u : 2u); ++k) result.parameters[k].fixed = true, result.parameters[k].std = 0.0;
   if (options.fixed.count("distortion") && !options.fixed.count("lens") && !LensD::kIsOrthographic)
     for (size_t k = 4; k < 6; ++k) result.parameters[k].fixed = true, result.parameters[k].std = 0.0;
+  result.covariance.resize(covariance_rows.size(), covariance_rows.size());
+  for (size_t i = 0; i < covariance_rows.size(); ++i)
+    for (size_t j = 0; j < covariance_rows.size(); ++j)
+      result.covariance(i, j) = covariance_internal(covariance_rows[i].first, covariance_rows[j].first) *
+                                covariance_rows[i].second * covariance_rows[j].second;
 
-  Model fitted = guess;
-  fitted.lens = LensD::FromParams(lens.data());
-  fitted.pose = MirrorPose<double>{m_mm, tilt[0], tilt[1], decenter[0], decenter[1]};
-  if constexpr (kPolynomial<ProfileD>) {
-    fitted.mirror = ProfileD::FromParams(shape.data(), shape_count);
-  } else if constexpr (!kTabulated<ProfileD>) {
-    fitted.mirror = ProfileD::FromParams(shape.data());
+  Model fitted = WithBlocks(guess, lens.data(), m_mm, tilt, decenter, shape.data(), shape_count);
+  // The written rim encloses every corner the sensor was fitted on (the fit lets
+  // reflections stray up to 15 % past the guess's rim): remap tables and the image area
+  // then cover all calibrated image.
+  {
+    Model wide = fitted;
+    wide.rim_radius_mm = std::min(1.15 * guess.rim_radius_mm, 0.99 * guess.mirror.MaxRadiusMm());
+    const Eigen::Matrix3d camera_from_mirror = fitted.pose.CameraFromMirrorRotation();
+    const Eigen::Vector3d mirror_origin = fitted.pose.CameraFromMirrorTranslation();
+    double widest_mm = fitted.rim_radius_mm;
+    for (const Residual& r : residuals) {
+      if (r.outlier) continue;
+      const Eigen::Quaterniond rotation(rotations[r.view][3], rotations[r.view][0], rotations[r.view][1], rotations[r.view][2]);
+      const Eigen::Vector3d in_camera = rotation * r.functor->point_in_target_mm +
+                                        Eigen::Vector3d(translations[r.view][0], translations[r.view][1], translations[r.view][2]);
+      Eigen::Vector3d mirror_point;
+      if (wide.ReflectionPoint(in_camera, &mirror_point) != ProjectionStatus::kOk) continue;
+      const Eigen::Vector3d in_mirror = camera_from_mirror.transpose() * (mirror_point - mirror_origin);
+      widest_mm = std::max(widest_mm, std::hypot(in_mirror.x(), in_mirror.y()));
+    }
+    // A hair beyond the widest so that the corner itself projects inside.
+    if (widest_mm > fitted.rim_radius_mm)
+      fitted.rim_radius_mm = std::min(widest_mm * (1.0 + 1e-6), 0.99 * fitted.mirror.MaxRadiusMm());
   }
   result.sensor = Sensor(fitted);
   for (size_t v = 0; v < views; ++v) {
@@ -398,35 +623,61 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
 
 }  // namespace
 
+namespace {
+
+// Calls each(name, value pointer, unit scale) for every parameter of a sensor's concrete
+// model, through copies of its blocks, and returns the model with the copies put back.
+template <typename Model, typename Each>
+Model WithEachParameter(Model model, const Each& each) {
+  using LensD = typename Model::LensType;
+  using ProfileD = typename Model::ProfileType;
+  std::vector<double> lens(LensD::kNumParams), shape(8, 0.0);
+  model.lens.ToParams(lens.data());
+  double m = model.pose.m_mm, tilt[2] = {model.pose.tilt_x_rad, model.pose.tilt_y_rad},
+         decenter[2] = {model.pose.decenter_x_mm, model.pose.decenter_y_mm};
+  int count = 0;
+  if constexpr (kPolynomial<ProfileD>) {
+    count = model.mirror.NumParams();
+    model.mirror.ToParams(shape.data());
+  } else if constexpr (!kTabulated<ProfileD>) {
+    count = ProfileD::kNumParams;
+    model.mirror.ToParams(shape.data());
+  }
+  ForEachParameter<LensD, ProfileD>(lens.data(), &m, tilt, decenter, shape.data(), count, each);
+  return WithBlocks(model, lens.data(), m, tilt, decenter, shape.data(), count);
+}
+
+}  // namespace
+
 std::vector<ParameterEstimate> SensorParameters(const Sensor& sensor) {
   std::vector<ParameterEstimate> parameters;
   std::visit(
       [&](const auto& model) {
-        using Model = std::decay_t<decltype(model)>;
-        using LensD = typename Model::LensType;
-        using ProfileD = typename Model::ProfileType;
-        std::vector<double> lens(LensD::kNumParams), shape(8, 0.0);
-        model.lens.ToParams(lens.data());
-        const double m = model.pose.m_mm, tilt[2] = {model.pose.tilt_x_rad, model.pose.tilt_y_rad},
-                     decenter[2] = {model.pose.decenter_x_mm, model.pose.decenter_y_mm};
-        int count = 0;
-        if constexpr (kPolynomial<ProfileD>) {
-          count = model.mirror.NumParams();
-          model.mirror.ToParams(shape.data());
-        } else if constexpr (!kTabulated<ProfileD>) {
-          count = ProfileD::kNumParams;
-          model.mirror.ToParams(shape.data());
-        }
-        ForEachParameter<LensD, ProfileD>(lens.data(), &m, tilt, decenter, shape.data(), count,
-                                          [&](const std::string& name, const double* block, int index, double scale) {
-                                            ParameterEstimate e;
-                                            e.name = name;
-                                            e.value = block[index] * scale;
-                                            parameters.push_back(e);
-                                          });
+        WithEachParameter(model, [&](const std::string& name, double* block, int index, double scale) {
+          ParameterEstimate e;
+          e.name = name;
+          e.value = block[index] * scale;
+          parameters.push_back(e);
+        });
       },
       sensor.model());
   return parameters;
+}
+
+Sensor SensorWithParameters(const Sensor& sensor, const std::vector<double>& values) {
+  return std::visit(
+      [&](const auto& model) {
+        size_t next = 0;
+        const auto changed = WithEachParameter(model, [&](const std::string&, double* block, int index, double scale) {
+          if (next < values.size()) block[index] = values[next] / scale;
+          ++next;
+        });
+        if (next != values.size())
+          throw std::invalid_argument("SensorWithParameters: " + std::to_string(values.size()) + " values for " +
+                                      std::to_string(next) + " parameters");
+        return Sensor(changed);
+      },
+      sensor.model());
 }
 
 FitOptions FitOptions::DefaultsFor(const Sensor& sensor) {
@@ -449,7 +700,24 @@ std::string FitOptions::Check() const {
     if (!kBlocks.count(name))
       return "--fix: unknown block '" + name + "' (lens, lens_scale, distortion, m, tilt, decenter, shape, poses)";
   if (!(robust_loss_px >= 0.0)) return "--loss-px: must be >= 0";
+  if (!(outlier_floor_px >= 0.0) || !(outlier_sigmas > 0.0) || !(view_rms_ratio > 1.0))
+    return "outlier rule: outlier_floor_px >= 0, outlier_sigmas > 0 and view_rms_ratio > 1";
   if (max_iterations < 1) return "--max-iterations: must be >= 1";
+  return {};
+}
+
+std::string FitOptions::CheckFor(const Sensor& sensor) const {
+  if (std::string why = Check(); !why.empty()) return why;
+  std::set<std::string> names;
+  std::string list;
+  for (const ParameterEstimate& p : SensorParameters(sensor)) names.insert(p.name), list += p.name + ", ";
+  for (const auto& [key, tolerance] : tolerances) {
+    for (const std::string& name : ToleranceTargets(key))
+      if (!names.count(name))
+        return "tolerances." + key + ": not a parameter of this " + sensor.profile_name() + " / " + sensor.lens_name() +
+               " sensor (" + list + "tilt_deg, decenter_mm, principal_point_px, focal_px)";
+    if (!(tolerance > 0.0) || !std::isfinite(tolerance)) return "tolerances." + key + ": must be a positive number";
+  }
   return {};
 }
 

@@ -20,6 +20,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -36,11 +37,29 @@ struct FitOptions {
   double robust_loss_px = 1.0;  // robust scale in px (Cauchy, outlier removal, then Huber); 0 = plain least squares
   int max_iterations = 200;
   bool compute_covariance = true;
+  // Outliers (robust mode): |residual| beyond max(outlier_floor_px, outlier_sigmas x a
+  // robust sigma of the residuals) are removed. The floor keeps a very good fit (renders:
+  // 0.02 px) from throwing good corners away; 4 sigma of a 2-D Gaussian's |e| cuts 3e-4.
+  double outlier_floor_px = 0.5;
+  double outlier_sigmas = 4.0;
+  // A view whose inlier RMS exceeds max(outlier_floor_px, view_rms_ratio x the median of
+  // the views' RMS) is left out (robust mode): it shows something else than the other
+  // views' board. Real views differ by up to 2.5x (measured on the dev set).
+  double view_rms_ratio = 4.0;
+  // Design tolerances: one standard deviation of a Gaussian prior around the guess's value,
+  // per parameter name as FitResult names them (fx_px, cx_px, k1, m_mm, decenter_x_mm,
+  // A_mm, ...) or a pair: tilt_deg, decenter_mm, principal_point_px, focal_px. They pull
+  // the fit towards the design (a weak prior residual: the wrong basins of the camera
+  // rotation / decenter / distortion valley lie many tolerances away) and enter the
+  // covariance. A tolerance on a held parameter is ignored.
+  std::map<std::string, double> tolerances;
 
   // The gauge-fixing defaults for a sensor (see above).
   static FitOptions DefaultsFor(const Sensor& sensor);
   // Empty if valid, else "field: problem".
   std::string Check() const;
+  // Check() and the tolerance names against the sensor's parameters ("tolerances.x: ...").
+  std::string CheckFor(const Sensor& sensor) const;
 };
 
 struct TargetPose {
@@ -56,7 +75,7 @@ struct ParameterEstimate {
 };
 
 struct FitResult {
-  std::optional<Sensor> sensor;
+  std::optional<Sensor> sensor;  // its rim enlarged, if needed, to enclose every fitted corner's reflection
   std::vector<TargetPose> poses;
   std::vector<ParameterEstimate> parameters;
   double rms_px = 0.0;  // per corner, over the inliers
@@ -64,16 +83,34 @@ struct FitResult {
   // Residual (observed - predicted... as fitted: predicted - observed) per view, per corner
   // in the order of the detections; NaN where the corner was dropped.
   std::vector<std::vector<Eigen::Vector2d>> residuals_px;
-  int outliers = 0;  // gross outliers removed (robust mode: beyond 5 sigma from the median residual)
+  int outliers = 0;  // gross outliers removed (robust mode, see FitOptions)
+  std::vector<int> per_view_outliers;
+  double outlier_threshold_px = 0.0;  // the |residual| beyond which corners were removed (0: none)
   int dropped = 0;   // observations not projectable at the initial guess
   int observations = 0;
+  // Per view: empty if the view was fitted, else why it was left out (too few corners
+  // projectable at the guess, or left after outlier removal). A left-out view's pose is
+  // not estimated and its per-view RMS is NaN; it never makes the covariance singular.
+  std::vector<std::string> view_left_out;
   bool converged = false;
   std::string solver_report;
   bool covariance_ok = false;
+  // The covariance of the free sensor parameters (poses marginalised: their coupling is
+  // in it), in the units of `parameters`, rows in the order of covariance_names.
+  Eigen::MatrixXd covariance;
+  std::vector<std::string> covariance_names;
+  // Parameters that ended more than 3 tolerances from their design values, one line each.
+  std::vector<std::string> tolerance_conflicts;
+  double guess_rim_radius_mm = 0.0;  // the guess's rim, for comparison with the fitted sensor's
+  // Corner residuals' standard deviation per coordinate (px), from the fit's RMS and its
+  // degrees of freedom: what the covariance is scaled by.
+  double sigma_px = 0.0;
 };
 
 // The sensor's parameters in FitResult's naming and units (values only, std 0).
 std::vector<ParameterEstimate> SensorParameters(const Sensor& sensor);
+// The sensor with its parameters set to `values` (SensorParameters' order and units).
+Sensor SensorWithParameters(const Sensor& sensor, const std::vector<double>& values);
 
 // The target's pose in a view from its detections through a sensor: rays of the detected
 // pixels, a central approximation at their mean origin, then PnP (OpenCV) on the bearing

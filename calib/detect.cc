@@ -1,5 +1,6 @@
 #include "calib/detect.h"
 
+#include "calib/bilinear.h"
 #include "calib/virtual_view.h"
 
 #include <Eigen/Geometry>
@@ -7,7 +8,6 @@
 #include <apriltag/tag36h11.h>
 #include <apriltag/tagStandard41h12.h>
 
-#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -59,6 +59,41 @@ std::map<int, std::array<Eigen::Vector2d, 4>> DetectTags(const CalibrationTarget
   return tags;
 }
 
+// Whether a checkerboard's ids, in order (id = row * cols + col, rows upwards), are the
+// board's turned by 180 deg about its normal: the grid's corner set is the same either way.
+// The board's bottom-left square is ink (calib/target.h). With cols + rows odd the turn
+// swaps the colours of the squares at corner 0, so the print decides: the squares at
+// corner 0 on its (-x, -y) / (+x, +y) diagonal are dark in the board's order. With cols +
+// rows even the board is symmetric and the order is a convention: rows count up away from
+// the image centre, which for a board held upright around a vertical mirror axis is up
+// (larger Omega images farther out), so the poses of such boards come out upright.
+bool CheckerboardTurnedAround(const CalibrationTarget& target, const cv::Mat& grey,
+                              const std::vector<CornerObservation>& corners) {
+  const int cols = target.cols(), rows = target.rows();
+  if (static_cast<int>(corners.size()) != cols * rows || cols < 2 || rows < 2) return false;
+  auto at = [&](int row, int col) { return corners[row * cols + col].pixel; };
+  if ((cols + rows) % 2 == 1) {
+    const Eigen::Vector2d origin = at(0, 0), along_x = at(0, 1) - origin, along_y = at(1, 0) - origin;
+    auto square = [&](double sx, double sy) {  // mean of a few samples inside the square
+      double sum = 0.0;
+      int count = 0;
+      for (double f : {0.3, 0.5}) {
+        const Eigen::Vector2d p = origin + f * (sx * along_x + sy * along_y);
+        const double value = Bilinear<uchar>(grey, p.x(), p.y());
+        if (std::isfinite(value)) sum += value, ++count;
+      }
+      return count ? sum / count : NAN;
+    };
+    const double diagonal = square(-1, -1) + square(1, 1), other = square(1, -1) + square(-1, 1);
+    if (std::isfinite(diagonal) && std::isfinite(other)) return diagonal > other;
+  }
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero(), up = Eigen::Vector2d::Zero();
+  for (const CornerObservation& c : corners) centre += c.pixel / corners.size();
+  for (int col = 0; col < cols; ++col) up += at(rows - 1, col) - at(0, col);
+  const Eigen::Vector2d image_centre(0.5 * (grey.cols - 1), 0.5 * (grey.rows - 1));
+  return up.dot(centre - image_centre) < 0.0;
+}
+
 }  // namespace
 
 ImageDetections DetectAprilGrid(const CalibrationTarget& target, const cv::Mat& grey, DetectionStats* stats,
@@ -79,23 +114,32 @@ ImageDetections DetectAprilGrid(const CalibrationTarget& target, const cv::Mat& 
   return image;
 }
 
-ImageDetections DetectCheckerboard(const CalibrationTarget& target, const cv::Mat& grey) {
+ImageDetections DetectCheckerboard(const CalibrationTarget& target, const cv::Mat& grey,
+                                   std::vector<CheckerboardCandidate>* candidates) {
   if (target.type() != CalibrationTarget::Type::kCheckerboard)
     throw std::invalid_argument("not a checkerboard target");
-  cv::Mat flipped;
-  cv::flip(grey, flipped, 1);  // undo the mirror's reversal of handedness
-  std::vector<cv::Point2f> corners;
+  CheckerboardCandidateOptions options;
+  options.mirrored = true;  // undo the mirror's reversal of handedness
+  std::vector<CheckerboardCandidate> found = FindCheckerboardCandidates(grey, cv::Size(target.cols(), target.rows()), options);
+  const CheckerboardCandidate* best = nullptr;
+  for (const CheckerboardCandidate& candidate : found)
+    if (candidate.accepted && (!best || candidate.contrast > best->contrast)) best = &candidate;
   ImageDetections image;
-  if (!cv::findChessboardCornersSB(flipped, cv::Size(target.cols(), target.rows()), corners,
-                                   cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY))
-    return image;
-  for (int i = 0; i < static_cast<int>(corners.size()); ++i) {
-    const int row_down = i / target.cols(), col = i % target.cols();
-    const int id = (target.rows() - 1 - row_down) * target.cols() + col;  // rows counted upwards
-    image.corners.push_back({id, Eigen::Vector2d(grey.cols - 1 - corners[i].x, corners[i].y)});
+  if (best) {
+    // findChessboardCornersSB's order on the flipped image: row-major, rows downwards.
+    for (int i = 0; i < static_cast<int>(best->grid.corners_px.size()); ++i) {
+      const int row_down = i / target.cols(), col = i % target.cols();
+      const int id = (target.rows() - 1 - row_down) * target.cols() + col;  // rows counted upwards
+      image.corners.push_back({id, best->grid.corners_px[i]});
+    }
+    std::sort(image.corners.begin(), image.corners.end(),
+              [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; });
+    if (CheckerboardTurnedAround(target, grey, image.corners))
+      for (CornerObservation& c : image.corners) c.id = target.cols() * target.rows() - 1 - c.id;
+    std::sort(image.corners.begin(), image.corners.end(),
+              [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; });
   }
-  std::sort(image.corners.begin(), image.corners.end(),
-            [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; });
+  if (candidates) *candidates = std::move(found);
   return image;
 }
 

@@ -4,9 +4,12 @@
 // (calib/target.h; Kalibr's order), checked on a printed board in tests/detect_test.cc.
 //
 // Checkerboards: OpenCV's findChessboardCornersSB (EXHAUSTIVE | ACCURACY) on the flipped
-// image. Its row-major order is read with rows counted upwards, which makes the id
-// assignment a proper rotation of the board; a checkerboard's corner set maps onto itself
-// under the remaining 180 deg ambiguity, so a fit is unaffected by it.
+// image, repeated until every candidate grid is found (calib/checkerboard_candidates.h).
+// Its row-major order is read with rows counted upwards, which makes the id assignment a
+// proper rotation of the board. The remaining 180 deg turn (the grid's corner set maps onto
+// itself, so a fit is unaffected, but the pose turns) is resolved by the print's colours
+// where the board has them (cols + rows odd), else by a convention: rows count up away from
+// the image centre (an upright board around a vertical mirror axis).
 //
 // Sub-pixel refinement of what these find: calib/refine_corners.h.
 #pragma once
@@ -14,7 +17,9 @@
 #include <opencv2/core.hpp>
 
 #include <string>
+#include <vector>
 
+#include "calib/checkerboard_candidates.h"
 #include "calib/detections.h"
 #include "calib/target.h"
 #include "model/sensor.h"
@@ -33,9 +38,14 @@ struct DetectionStats {
 ImageDetections DetectAprilGrid(const CalibrationTarget& target, const cv::Mat& grey, DetectionStats* stats = nullptr,
                                 bool mirrored = true);
 
-// The checkerboard's inner corners, all or none. Throws std::invalid_argument for
-// another target type.
-ImageDetections DetectCheckerboard(const CalibrationTarget& target, const cv::Mat& grey);
+// The checkerboard's inner corners, all or none. Every candidate grid in the image is
+// considered and one that is a patch of a larger checker pattern (tiles, a checked floor)
+// is refused (calib/checkerboard_candidates.h); of the accepted ones, the one with the most
+// contrast (printed ink on paper). `candidates` (optional) receives every candidate with
+// its refusal reason, for the caller's warnings. Throws std::invalid_argument for another
+// target type.
+ImageDetections DetectCheckerboard(const CalibrationTarget& target, const cv::Mat& grey,
+                                   std::vector<CheckerboardCandidate>* candidates = nullptr);
 
 // Either, by the target's type.
 ImageDetections DetectTarget(const CalibrationTarget& target, const cv::Mat& grey);

@@ -43,6 +43,7 @@ double EnvironmentAt(const Environment& env, const Eigen::Vector3d& origin, cons
     const double tk = ((direction[k] > 0.0 ? env.half_size_mm : -env.half_size_mm) - origin[k]) / direction[k];
     if (tk > 0.0 && tk < t) t = tk, axis = k;
   }
+  if (axis != 2 && !env.tiled_walls) return 0.5 * (env.low + env.high);
   const Eigen::Vector3d hit = origin + t * direction;
   const int a = static_cast<int>(std::floor(hit[(axis + 1) % 3] / env.tile_mm));
   const int b = static_cast<int>(std::floor(hit[(axis + 2) % 3] / env.tile_mm));

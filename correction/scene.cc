@@ -102,7 +102,7 @@ Scene LoadSceneYaml(const std::string& path) {
       if (f.vignetting < 0.0 || f.vignetting > 1.0) reader.Fail("render.vignetting", "must be in [0, 1]");
     }
     if (const YAML::Node env = root["environment"]) {
-      reader.RejectUnknown(env, "environment", {"type", "level", "half_size_mm", "tile_mm", "levels"});
+      reader.RejectUnknown(env, "environment", {"type", "level", "half_size_mm", "tile_mm", "levels", "tiles"});
       Environment& e = scene.environment;
       const std::string type = env["type"] ? env["type"].as<std::string>() : "room";
       if (type == "grey") {
@@ -115,6 +115,12 @@ Scene LoadSceneYaml(const std::string& path) {
       e.tile_mm = reader.NumberOr(env, "tile_mm", "environment", e.tile_mm);
       const auto levels = reader.Range(env, "levels", "environment", {e.low, e.high});
       e.low = levels.first, e.high = levels.second;
+      if (env["tiles"]) {
+        const std::string tiles = reader.Text(env["tiles"], "environment.tiles");
+        if (tiles != "all" && tiles != "floor_ceiling")
+          reader.Fail("environment.tiles", "must be all or floor_ceiling, not '" + tiles + "'");
+        e.tiled_walls = tiles == "all";
+      }
       if (!(e.half_size_mm > 0.0) || !(e.tile_mm > 0.0)) reader.Fail("environment", "half_size_mm and tile_mm must be > 0");
     }
 

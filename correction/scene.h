@@ -25,6 +25,9 @@ struct Environment {
   double half_size_mm = 3000.0;   // room: a cube around the sensor
   double tile_mm = 300.0;         // room: checker tiles on its walls
   double low = 0.25, high = 0.55;  // room: the two tile reflectances
+  // room: tiles on every face, or only on the floor and ceiling (the faces across the
+  // camera's z axis, the mirror's axis) with plain walls at the tiles' mean level.
+  bool tiled_walls = true;
 };
 
 struct ImageFormation {

@@ -255,7 +255,8 @@ Sensor SensorFromRoot(const YAML::Node& root, const FieldReader& reader) {
   const std::string& path = reader.path();
   if (!root.IsMap()) reader.Fail("", "expected a map with camera, mirror and pose sections");
   try {
-    reader.RejectUnknown(root, "", {"camera", "mirror", "pose"});
+    // tolerances: the design tolerances of a guess, read by calib (design_tolerances.h).
+    reader.RejectUnknown(root, "", {"camera", "mirror", "pose", "tolerances"});
     const LensChoice lens = ReadCamera(reader, root);
     const MirrorPose<double> pose = ReadPose(reader, root);
     SensorModel model = ReadMirror(reader, root, lens, pose);

@@ -17,7 +17,9 @@
 #include <thread>
 
 #include "calib/bundle_fit.h"
+#include "calib/design_tolerances.h"
 #include "calib/initial_sensor.h"
+#include "calib/predicted_error.h"
 #include "calib/rim_circle.h"
 #include "model/atomic_write.h"
 #include "model/input_error.h"
@@ -36,6 +38,9 @@ struct Options {
   int max_iterations = 200;
   bool leave_one_out = false;
   int detection_passes = 2;
+  std::string tolerance;
+  std::vector<double> distances_mm, distances_n;
+  double max_predicted_error_px = 0.3;
 };
 
 std::set<std::string> SplitList(const std::string& text) {
@@ -45,6 +50,31 @@ std::set<std::string> SplitList(const std::string& text) {
   while (std::getline(stream, item, ','))
     if (!item.empty()) items.insert(item);
   return items;
+}
+
+// A map of the predicted projection error over the observed field, one cell per grid pixel.
+void WritePredictedErrorMap(const std::string& path, const Sensor& sensor, const PredictedError& map, double step_px,
+                            double threshold_px, const std::string& label) {
+  cv::Mat picture(sensor.image_height_px(), sensor.image_width_px(), CV_8UC3, cv::Scalar(30, 30, 30));
+  // Colour scale from 0 to the larger of the worst value and the warning threshold, so a
+  // map under the threshold never looks alarming.
+  const double top = std::max(threshold_px, map.max_px);
+  for (size_t k = 0; k < map.pixels.size(); ++k) {
+    if (!std::isfinite(map.std_px[k])) continue;
+    cv::Mat level(1, 1, CV_8U, cv::Scalar(static_cast<int>(std::lround(255.0 * std::min(1.0, map.std_px[k] / top)))));
+    cv::Mat colour;
+    cv::applyColorMap(level, colour, cv::COLORMAP_VIRIDIS);
+    const cv::Vec3b c = colour.at<cv::Vec3b>(0, 0);
+    const cv::Point2d corner(map.pixels[k].x() - 0.5 * step_px, map.pixels[k].y() - 0.5 * step_px);
+    cv::rectangle(picture, cv::Rect2d(corner, cv::Size2d(step_px, step_px)), cv::Scalar(c[0], c[1], c[2]), cv::FILLED);
+  }
+  char text[200];
+  std::snprintf(text, sizeof text, "predicted error at %s: median %.3f px, worst %.3f px", label.c_str(), map.median_px,
+                map.max_px);
+  cv::putText(picture, text, {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  std::snprintf(text, sizeof text, "colour: 0 (purple) to %.3f px (yellow); warning above %.2f px", top, threshold_px);
+  cv::putText(picture, text, {10, 48}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  WritePng(path, picture);
 }
 
 void WriteReport(const std::filesystem::path& dir, const DetectionSet& detections, const FitResult& fit) {
@@ -239,6 +269,18 @@ void Run(const Options& options, const Context& context) {
   fit_options.robust_loss_px = options.loss_px;
   fit_options.max_iterations = options.max_iterations;
   if (const std::string why = fit_options.Check(); !why.empty()) throw InputError(why);
+  // Design tolerances: the guess file's, then --tolerance's (which win).
+  if (given) {
+    fit_options.tolerances = ReadDesignTolerances(options.sensor_path, *given);
+    // Converted to another family: the old family's shape tolerances do not apply.
+    for (auto it = fit_options.tolerances.begin(); it != fit_options.tolerances.end();) {
+      FitOptions one;
+      one.tolerances = {*it};
+      it = one.CheckFor(guess).empty() ? std::next(it) : fit_options.tolerances.erase(it);
+    }
+  }
+  for (const auto& [name, value] : ParseDesignTolerances(options.tolerance, "--tolerance")) fit_options.tolerances[name] = value;
+  if (const std::string why = fit_options.CheckFor(guess); !why.empty()) throw InputError("--tolerance: " + why);
 
   int unrefined = 0;
   UsableViews views = ViewsForFit(guess, target, FittableCorners(target, options.target_path, source, detections, &unrefined),
@@ -353,6 +395,96 @@ void Run(const Options& options, const Context& context) {
                   nearest_mm, farthest_mm, kOneDistanceRatio);
     warnings.push_back(text);
   }
+  // Views the fit left out, and why (their corners are in the report, marked dropped).
+  for (size_t v = 0; v < usable.images.size(); ++v)
+    if (!fit.view_left_out[v].empty()) {
+      warnings.push_back(usable.images[v].image + ": view left out of the fit: " + fit.view_left_out[v]);
+      result["views_left_out"][usable.images[v].image] = fit.view_left_out[v];
+    }
+  for (const std::string& conflict : fit.tolerance_conflicts) warnings.push_back(conflict);
+  result["outlier_threshold_px"] = fit.outlier_threshold_px;
+  for (size_t v = 0; v < usable.images.size(); ++v) result["per_view_outliers"][usable.images[v].image] = fit.per_view_outliers[v];
+  result["sigma_px"] = fit.sigma_px;
+  result["tolerances"] = fit_options.tolerances;
+  result["rim_radius_mm"] = {{"guess", fit.guess_rim_radius_mm}, {"fitted", fit.sensor->rim_radius_mm()}};
+  if (fit.covariance_ok) {
+    result["covariance"]["names"] = fit.covariance_names;
+    for (int r = 0; r < fit.covariance.rows(); ++r) {
+      std::vector<double> row(fit.covariance.cols());
+      for (int c = 0; c < fit.covariance.cols(); ++c) row[c] = fit.covariance(r, c);
+      result["covariance"]["matrix"].push_back(row);
+    }
+  }
+  // The error at the user's distances: the covariance through the projection over the
+  // observed field (calib/predicted_error.h). Default: the corners' median distance from
+  // their reflection points, and infinity.
+  std::vector<PredictedError> predicted;
+  std::vector<std::string> distance_labels;
+  const double rim_mm = fit.guess_rim_radius_mm;  // n counts design rim radii
+  constexpr double kMapStepPx = 16.0;
+  if (fit.covariance_ok) {
+    std::vector<double> distances = options.distances_mm;
+    for (double n : options.distances_n) distances.push_back(n * fit.guess_rim_radius_mm);
+    if (distances.empty()) {
+      std::vector<double> corner_distances;
+      for (size_t v = 0; v < usable.images.size(); ++v)
+        for (const CornerObservation& c : usable.images[v].corners) {
+          const auto found = std::find_if(target.corners().begin(), target.corners().end(),
+                                          [&](const TargetCorner& t) { return t.id == c.id; });
+          if (found == target.corners().end() || !fit.view_left_out[v].empty()) continue;
+          const Eigen::Vector3d in_camera =
+              fit.poses[v].camera_from_target_rotation * found->point_in_target + fit.poses[v].camera_from_target_translation_mm;
+          Eigen::Vector3d mirror_point;
+          if (std::visit([&](const auto& m) { return m.ReflectionPoint(in_camera, &mirror_point, &fit.sensor->cache()); },
+                         fit.sensor->model()) == ProjectionStatus::kOk)
+            corner_distances.push_back((in_camera - mirror_point).norm());
+        }
+      double median = NAN, farthest = NAN;
+      MedianAndMax(corner_distances, &median, &farthest);
+      if (std::isfinite(median)) distances.push_back(median);
+      distances.push_back(kInfinityMm);
+    }
+    const std::vector<Eigen::Vector2d> field = FieldPixels(*fit.sensor, FieldOfCorners(*fit.sensor, usable), kMapStepPx);
+    predicted = PredictProjectionError(*fit.sensor, fit, field, distances);
+    for (const PredictedError& map : predicted) {
+      const bool infinite = map.distance_mm >= kInfinityMm;
+      char label[80];
+      if (infinite) {
+        std::snprintf(label, sizeof label, "infinity");
+      } else {
+        std::snprintf(label, sizeof label, "%.0f mm (n = %.2f)", map.distance_mm, map.distance_mm / rim_mm);
+      }
+      distance_labels.push_back(label);
+      result["predicted_error"].push_back({{"distance_mm", infinite ? nlohmann::json("infinity") : nlohmann::json(map.distance_mm)},
+                                           {"n_rim_radii", infinite ? nlohmann::json("infinity") : nlohmann::json(map.distance_mm / rim_mm)},
+                                           {"median_px", map.median_px},
+                                           {"max_px", map.max_px},
+                                           {"field_pixels", map.pixels.size()}});
+      if (map.max_px > options.max_predicted_error_px) {
+        // What would help: the valleys the data leave open (README "When the predicted
+        // error warning fires").
+        std::vector<std::string> help;
+        if (farthest_mm < kOneDistanceRatio * nearest_mm) help.push_back("boards at other distances");
+        const bool distortion_free = std::any_of(fit.parameters.begin(), fit.parameters.end(), [](const ParameterEstimate& p) {
+          return (p.name == "k1" || p.name == "k2") && !p.fixed;
+        });
+        if (distortion_free) help.push_back("the distortion held (--fix distortion)");
+        if (fit_options.tolerances.empty()) help.push_back("design tolerances (--tolerance)");
+        help.push_back("more views over the whole field");
+        std::string joined;
+        for (size_t k = 0; k < help.size(); ++k) joined += (k ? (k + 1 == help.size() ? " or " : ", ") : "") + help[k];
+        char text[400];
+        std::snprintf(text, sizeof text,
+                      "predicted projection error up to %.2f px (median %.2f) at %s exceeds %.2f px: the calibration "
+                      "may misplace objects there by that much; %s would help",
+                      map.max_px, map.median_px, label, options.max_predicted_error_px, joined.c_str());
+        warnings.push_back(text);
+      }
+    }
+    result["predicted_error_definition"] =
+        "per pixel of the observed field: sqrt(trace(J C J^T)), the RMS length of the 2-D error vector of a point at "
+        "that distance from its reflection point, C the fit's covariance (poses marginalised)";
+  }
   result["warnings"] = warnings;
   for (size_t v = 0; v < usable.images.size(); ++v) result["per_view_rms_px"][usable.images[v].image] = fit.per_view_rms_px[v];
   for (const ParameterEstimate& p : fit.parameters)
@@ -360,6 +492,7 @@ void Run(const Options& options, const Context& context) {
                                     {"std", std::isfinite(p.std) ? nlohmann::json(p.std) : nlohmann::json(nullptr)},
                                     {"fixed", p.fixed}};
   for (size_t v = 0; v < usable.images.size(); ++v) {
+    if (!fit.view_left_out[v].empty()) continue;
     const TargetPose& pose = fit.poses[v];
     const Eigen::Quaterniond& q = pose.camera_from_target_rotation;
     result["poses"][usable.images[v].image] = {
@@ -375,6 +508,9 @@ void Run(const Options& options, const Context& context) {
   if (!options.images.empty()) WriteDetections(detections, (dir / "detections.json").string());
   WriteFileAtomically((dir / "calibration.json").string(), [&](std::ostream& out) { out << result.dump(2) << '\n'; });
   WriteReport(dir / "report", usable, fit);
+  for (size_t k = 0; k < predicted.size(); ++k)
+    WritePredictedErrorMap((dir / "report" / ("predicted_error_" + std::to_string(k) + ".png")).string(), *fit.sensor,
+                           predicted[k], kMapStepPx, options.max_predicted_error_px, distance_labels[k]);
   for (const std::string& w : warnings) std::fprintf(stderr, "omnical: warning: %s\n", w.c_str());
   if (!context.quiet) {
     std::printf("%zu views, %d corners: RMS %.4f px, %s; -> %s\n", usable.images.size(), observations, fit.rms_px,
@@ -421,6 +557,18 @@ Command CalibrateCommand() {
                            "With --images and an aprilgrid: pass 2 re-detects the corners through the first fit's "
                            "sensor and fits again (1: a single pass)")
                 ->check(CLI::Range(1, 5))->capture_default_str();
+            sub.add_option("--tolerance", options->tolerance,
+                           "Design tolerances (one std) as weak priors, name=value,...: e.g. m_mm=2,decenter_mm=1,"
+                           "tilt_deg=1,principal_point_px=10,k1=0.05 (adds to / overrides the guess file's tolerances:)");
+            sub.add_option("--distance-mm", options->distances_mm,
+                           "Distances (mm from the reflection point) at which to predict the projection error "
+                           "(repeatable; default: the boards' median distance and infinity)")
+                ->check(kPositive);
+            sub.add_option("--distance-n", options->distances_n, "The same in mirror rim radii (the seed paper's n)")
+                ->check(kPositive);
+            sub.add_option("--max-predicted-error-px", options->max_predicted_error_px,
+                           "Warn when the predicted projection error anywhere in the observed field exceeds this")
+                ->check(CLI::Range(0.0, 1000.0))->capture_default_str();
             sub.add_flag("--leave-one-out", options->leave_one_out,
                          "Also fit without each image in turn; calibration.json gets each parameter's spread");
             return [options, &context]() { Run(*options, context); };

@@ -46,6 +46,7 @@ DetectedImages DetectImages(const CalibrationTarget& target, const std::string& 
   std::vector<cv::Size> sizes(paths.size());
   std::vector<std::string> problems(paths.size());
   std::vector<std::optional<RimCircle>> circles(paths.size());
+  std::vector<std::vector<std::string>> refusals(paths.size());  // checkerboard candidates refused, per image
   std::atomic<size_t> next{0};
   {
     Progress progress("detect", static_cast<long>(paths.size()), options.quiet);
@@ -56,7 +57,14 @@ DetectedImages DetectImages(const CalibrationTarget& target, const std::string& 
           problems[i] = "cannot read the image";
         } else {
           sizes[i] = grey.size();
-          found[i] = DetectTarget(target, grey);
+          if (target.type() == CalibrationTarget::Type::kCheckerboard) {
+            std::vector<CheckerboardCandidate> candidates;
+            found[i] = DetectCheckerboard(target, grey, &candidates);
+            for (const CheckerboardCandidate& c : candidates)
+              if (!c.accepted) refusals[i].push_back(c.refusal);
+          } else {
+            found[i] = DetectTarget(target, grey);
+          }
           const Sensor* guess = options.guess && grey.cols == options.guess->image_width_px() &&
                                         grey.rows == options.guess->image_height_px()
                                     ? options.guess
@@ -86,6 +94,8 @@ DetectedImages DetectImages(const CalibrationTarget& target, const std::string& 
     }
     if (problems[i].empty() && sizes[i] != cv::Size(out.detections.image_width_px, out.detections.image_height_px))
       problems[i] = "its size differs from the first image's";
+    for (const std::string& why : refusals[i])
+      std::cerr << "omnical: warning: " << paths[i] << ": a checkerboard-like grid refused: " << why << "\n";
     if (!problems[i].empty()) {
       std::cerr << "omnical: warning: " << paths[i] << ": " << problems[i] << ", skipped\n";
       continue;

@@ -47,6 +47,9 @@ p = result["parameters"]
 print("rms %.4f px, %d outliers, %d detection passes" % (result["rms_px"], result["outliers"], result["detection_passes"]))
 check(result["converged"], "converged")
 check(result["rms_px"] < 0.1, "RMS %.4f px < 0.1" % result["rms_px"])
+# Noise-free renders: the outlier rule keeps the corners (the trust issue: < 0.5 %).
+check(result["outliers"] < 0.005 * result["observations"],
+      "%d of %d corners flagged as outliers (< 0.5 %%)" % (result["outliers"], result["observations"]))
 for name, value in truth.items():
     e = p[name]
     if e["fixed"]: continue

@@ -242,10 +242,76 @@ calibrate_error calibrate_one_pose "all views show the target at one pose" --tar
 calibrate_error calibrate_spec_matches_nothing "matches no corner id" --target "$work/other_ids.yaml" --detections "$work/det.json"
 calibrate_error calibrate_image_size "image_size: 1000 x 1000 differs from the sensor's 1040 x 1040" --target "$grid" --detections "$work/det_size.json"
 calibrate_error calibrate_unknown_block "--fix: unknown block 'focal'" --target "$grid" --detections "$work/det.json" --fix focal
+calibrate_error calibrate_unknown_tolerance "--tolerance: tolerances.B_mm: not a parameter of this sphere / pinhole sensor" \
+  --target "$grid" --detections "$work/det.json" --tolerance B_mm=1
+calibrate_error calibrate_tolerance_syntax "--tolerance: 'm_mm' is not name=value" --target "$grid" --detections "$work/det.json" --tolerance m_mm
+printf 'camera: { model: pinhole, image_size: [1040, 1040], fx: 2350, fy: 2350, cx: 519.5, cy: 519.5, k1: 0, k2: 0 }\nmirror: { profile: sphere, rim_radius: 43.9, A: 50 }\npose: { m: 180 }\ntolerances: { m_mm: -2 }\n' >"$work/guess_bad_tolerance.yaml"
+rm -rf "$work/cal_bad"
+expect_error calibrate_guess_tolerance "guess_bad_tolerance.yaml: tolerances.m_mm: must be a positive number" -- \
+  calibrate --target "$grid" --detections "$work/det.json" --sensor "$work/guess_bad_tolerance.yaml" --out "$work/cal_bad"
+# The error at the user's distance: tolerances from the guess file and the flag, one map
+# per asked distance, the whole covariance, and the predicted error in calibration.json.
+sed 's/^pose: .*/&\ntolerances: { m_mm: 2, decenter_mm: 1 }/' "$guess" >"$work/guess_tolerances.yaml"
+if "$omnical" -q calibrate --target "$grid" --detections "$work/det.json" --sensor "$work/guess_tolerances.yaml" \
+  --tolerance principal_point_px=10 --distance-n 2 --distance-mm 5000 --out "$work/cal_trust" 2>"$work/trust.err"; then
+  python3 - "$work/cal_trust/calibration.json" <<'PYTRUST' && pass || fail "calibrate: predicted error, tolerances, covariance"
+import json, sys
+d = json.load(open(sys.argv[1]))
+p = d["predicted_error"]
+assert [round(e["n_rim_radii"], 3) for e in p] == [round(5000 / 43.9, 3), 2.0], p   # --distance-mm first
+assert all(e["max_px"] >= e["median_px"] > 0 for e in p), p
+assert p[1]["max_px"] > p[0]["max_px"], p          # near objects are the uncertain ones
+assert d["tolerances"] == {"m_mm": 2, "decenter_mm": 1, "principal_point_px": 10}, d["tolerances"]
+names = d["covariance"]["names"]; c = d["covariance"]["matrix"]
+assert len(c) == len(names) and all(abs(c[i][i] ** 0.5 - d["parameters"][n]["std"]) < 1e-9 * (1 + c[i][i] ** 0.5) for i, n in enumerate(names))
+assert d["outlier_threshold_px"] >= 0.5 and d["rim_radius_mm"]["fitted"] >= d["rim_radius_mm"]["guess"]
+PYTRUST
+  [ -s "$work/cal_trust/report/predicted_error_0.png" ] && [ -s "$work/cal_trust/report/predicted_error_1.png" ] &&
+    [ ! -e "$work/cal_trust/report/predicted_error_2.png" ] && pass || fail "calibrate: predicted error maps"
+  # A threshold no fit can meet: the warning names the distance and what would help.
+  "$omnical" -q calibrate --target "$grid" --detections "$work/det.json" --sensor "$guess" --distance-n 2 \
+    --max-predicted-error-px 0.001 --out "$work/cal_trust2" 2>"$work/trust2.err" &&
+    grep -q "warning: predicted projection error up to .* at .* (n = 2.00) exceeds 0.00 px.*would help" "$work/trust2.err" &&
+    grep -q "predicted projection error" "$work/cal_trust2/calibration.json" && pass ||
+    fail "calibrate: predicted error warning: $(cat "$work/trust2.err")"
+else
+  fail "calibrate --distance-n --tolerance exited $?: $(cat "$work/trust.err")"
+fi
 # calibrate --images: detection inside calibrate (through the guess: virtual views and
 # refinement in patches; two detection passes; measured 0.033 px RMS), detections.json beside the results.
-if "$omnical" -q calibrate --target "$grid" --images "$rendered" --sensor "$guess" --out "$work/cal_img" 2>/dev/null; then
+if "$omnical" -q calibrate --target "$grid" --images "$rendered" --sensor "$guess" --distance-n 2 --distance-n 7 \
+  --out "$work/cal_img" 2>/dev/null; then
+  # The trust issue's near-only, k1/k2-free case from rendered images: the predicted error
+  # at n = 2 and 7 against the actual one (points along the true sensor's rays, projected
+  # through the calibrated one), on a 24 px grid of the observed annulus. Where the fit is
+  # off by more than the 0.3 px warning threshold, the prediction says so and its 3-sigma
+  # bound covers the actual error.
+  python3 - "$omnical" "$rendered/sensor.yaml" "$work/cal_img" "$work" <<'PYACTUAL' && pass || fail "calibrate --images: predicted vs actual error"
+import json, math, subprocess, sys
+omnical, truth, cal, work = sys.argv[1:5]
+d = json.load(open(cal + "/calibration.json"))
+pixels = [(u, v) for v in range(12, 1040, 24) for u in range(12, 1040, 24) if 150 < math.hypot(u - 519.5, v - 519.5) < 470]
+open(work + "/grid.csv", "w").write("u,v\n" + "".join("%g,%g\n" % p for p in pixels))
+rays = subprocess.run([omnical, "unproject", "--sensor", truth, "--pixels", work + "/grid.csv"], capture_output=True, text=True, check=True).stdout
+rows = [r.split(",") for r in rays.strip().splitlines() if r and r[0] != "o"]
+for e in d["predicted_error"]:
+    n = e["n_rim_radii"]; D = n * 43.9
+    kept, points = [], []
+    for p, r in zip(pixels, rows):
+        if r[6] != "ok": continue
+        o, k = [float(x) for x in r[0:3]], [float(x) for x in r[3:6]]
+        kept.append(p); points.append([o[i] + D * k[i] for i in range(3)])
+    open(work + "/pts.csv", "w").write("X,Y,Z\n" + "".join("%.12g,%.12g,%.12g\n" % tuple(q) for q in points))
+    out = subprocess.run([omnical, "project", "--sensor", cal + "/sensor.yaml", "--points", work + "/pts.csv"], capture_output=True, text=True, check=True).stdout
+    moved = [r.split(",") for r in out.strip().splitlines() if r and r[0] != "u"]
+    actual = max(math.dist(p, (float(m[0]), float(m[1]))) for p, m in zip(kept, moved) if m[2] == "ok")
+    print("n = %.0f: actual worst %.2f px, predicted %.2f px" % (n, actual, e["max_px"]))
+    assert actual <= 3 * e["max_px"] and (actual <= 0.3 or e["max_px"] > 0.3), (n, actual, e["max_px"])
+PYACTUAL
   near "$(json "$work/cal_img/calibration.json" rms_px)" 0.05 0.05 "calibrate --images RMS (px)"
+  # Noise-free renders: < 0.5 % of the corners flagged as outliers (the trust issue).
+  python3 -c "import json,sys; d=json.load(open(sys.argv[1])); sys.exit(0 if d['outliers'] < 0.005 * d['observations'] else 1)" \
+    "$work/cal_img/calibration.json" && pass || fail "calibrate --images: outliers on a noise-free render"
   [ -s "$work/cal_img/detections.json" ] && pass || fail "calibrate --images wrote no detections.json"
 else
   fail "calibrate --images exited $?"

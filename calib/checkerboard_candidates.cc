@@ -1,0 +1,317 @@
+#include "calib/checkerboard_candidates.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "calib/bilinear.h"
+
+namespace omnical {
+namespace {
+
+// Growth of a refused pattern before it is masked: tiles reflected around the image
+// centre can span ~50 steps; past that the extrapolation is not worth following.
+constexpr int kMaxGrowthSteps = 40;
+
+// The lines of a grid parallel to an edge, the edge first, going inwards.
+std::vector<std::vector<Eigen::Vector2d>> LinesFrom(const CheckerGrid& grid, GridEdge edge) {
+  const bool by_row = edge == GridEdge::kTop || edge == GridEdge::kBottom;
+  const int count = by_row ? grid.rows : grid.cols, length = by_row ? grid.cols : grid.rows;
+  std::vector<std::vector<Eigen::Vector2d>> lines(count);
+  for (int k = 0; k < count; ++k) {
+    const int line = (edge == GridEdge::kTop || edge == GridEdge::kLeft) ? k : count - 1 - k;
+    for (int i = 0; i < length; ++i) lines[k].push_back(by_row ? grid.at(line, i) : grid.at(i, line));
+  }
+  return lines;
+}
+
+// The points one grid step beyond an edge: quadratic along each grid line across the edge
+// (a mirror bends the grid; a straight-line guess drifts by a few px per step near the rim).
+std::vector<Eigen::Vector2d> Beyond(const std::vector<std::vector<Eigen::Vector2d>>& lines) {
+  std::vector<Eigen::Vector2d> beyond(lines[0].size());
+  for (size_t i = 0; i < beyond.size(); ++i)
+    beyond[i] = lines.size() >= 3 ? Eigen::Vector2d(3.0 * lines[0][i] - 3.0 * lines[1][i] + lines[2][i])
+                                  : Eigen::Vector2d(2.0 * lines[0][i] - lines[1][i]);
+  return beyond;
+}
+
+// The step along a line at index i (central where it can be).
+Eigen::Vector2d AlongStep(const std::vector<Eigen::Vector2d>& line, size_t i) {
+  if (line.size() < 2) return Eigen::Vector2d::Zero();
+  if (i == 0) return line[1] - line[0];
+  if (i + 1 == line.size()) return line[i] - line[i - 1];
+  return 0.5 * (line[i + 1] - line[i - 1]);
+}
+
+// The grid with one more line beyond `edge`.
+CheckerGrid Extended(const CheckerGrid& grid, GridEdge edge, const std::vector<Eigen::Vector2d>& beyond) {
+  CheckerGrid out;
+  const bool by_row = edge == GridEdge::kTop || edge == GridEdge::kBottom;
+  const bool before = edge == GridEdge::kTop || edge == GridEdge::kLeft;
+  out.rows = grid.rows + (by_row ? 1 : 0);
+  out.cols = grid.cols + (by_row ? 0 : 1);
+  out.corners_px.resize(out.rows * out.cols);
+  for (int r = 0; r < out.rows; ++r)
+    for (int c = 0; c < out.cols; ++c) {
+      const int r0 = by_row && before ? r - 1 : r, c0 = !by_row && before ? c - 1 : c;
+      const bool is_new = by_row ? (before ? r == 0 : r == out.rows - 1) : (before ? c == 0 : c == out.cols - 1);
+      out.corners_px[r * out.cols + c] = is_new ? beyond[by_row ? c : r] : grid.at(r0, c0);
+    }
+  return out;
+}
+
+// The image side each edge faces (kTop, kBottom, kLeft, kRight order), distinct names: of
+// the two pairs of opposite edges, the one whose outward steps are more horizontal is
+// "left"/"right", the other "top"/"bottom" (image y runs down).
+std::array<std::string, 4> FacingNames(const CheckerGrid& grid) {
+  std::array<Eigen::Vector2d, 4> outward;
+  int k = 0;
+  for (GridEdge edge : {GridEdge::kTop, GridEdge::kBottom, GridEdge::kLeft, GridEdge::kRight}) {
+    const auto lines = LinesFrom(grid, edge);
+    outward[k] = Eigen::Vector2d::Zero();
+    for (size_t i = 0; i < lines[0].size(); ++i) outward[k] += (lines[0][i] - lines[1][i]).normalized();
+    ++k;
+  }
+  std::array<std::string, 4> names;
+  const Eigen::Vector2d rows = outward[1] - outward[0], columns = outward[3] - outward[2];
+  const bool rows_horizontal = std::abs(rows.x()) / rows.norm() > std::abs(columns.x()) / columns.norm();
+  const int h = rows_horizontal ? 0 : 2, v = rows_horizontal ? 2 : 0;  // first edge of each pair
+  const bool h_first_left = outward[h].x() < outward[h + 1].x(), v_first_top = outward[v].y() < outward[v + 1].y();
+  names[h] = h_first_left ? "left" : "right";
+  names[h + 1] = h_first_left ? "right" : "left";
+  names[v] = v_first_top ? "top" : "bottom";
+  names[v + 1] = v_first_top ? "bottom" : "top";
+  return names;
+}
+
+// Per point beyond an edge: is it an X-junction (-1: not testable).
+std::vector<int> JunctionsBeyond(const cv::Mat& grey, const std::vector<std::vector<Eigen::Vector2d>>& lines,
+                                 const std::vector<Eigen::Vector2d>& beyond, double threshold) {
+  std::vector<int> out(beyond.size());
+  for (size_t i = 0; i < beyond.size(); ++i) {
+    const Eigen::Vector2d across = beyond[i] - lines[0][i], along = AlongStep(beyond, i);
+    const double score = XJunctionScore(grey, beyond[i], across, along);
+    out[i] = std::isnan(score) ? -1 : score > threshold;
+  }
+  return out;
+}
+
+// Two tested points at least: one junction alone may be a tile's corner by chance.
+bool Continues(const GridContinuation& edge, double fraction) {
+  return edge.tested >= 2 && edge.junctions >= fraction * edge.tested;
+}
+
+double Mean(const std::array<double, 9>& v) {
+  double sum = 0.0;
+  for (double x : v) sum += x;
+  return sum / v.size();
+}
+
+// Per edge, the X-junctions one step beyond it scoring above `threshold`.
+std::vector<GridContinuation> Continuations(const cv::Mat& grey, const CheckerGrid& grid, double threshold) {
+  const std::array<std::string, 4> facing = FacingNames(grid);
+  std::vector<GridContinuation> out;
+  for (GridEdge edge : {GridEdge::kTop, GridEdge::kBottom, GridEdge::kLeft, GridEdge::kRight}) {
+    const auto lines = LinesFrom(grid, edge);
+    GridContinuation continuation{edge, facing[static_cast<int>(edge)]};
+    for (int j : JunctionsBeyond(grey, lines, Beyond(lines), threshold))
+      if (j >= 0) ++continuation.tested, continuation.junctions += j;
+    out.push_back(continuation);
+  }
+  return out;
+}
+
+// Follows a refused pattern outwards while its edges keep showing X-junctions, each new
+// line pulled onto the junctions by cornerSubPix, so the whole pattern is masked at once
+// rather than found again patch by patch.
+CheckerGrid GrowPattern(const cv::Mat& grey, CheckerGrid grid, double threshold) {
+  for (int step = 0; step < kMaxGrowthSteps; ++step) {
+    bool grew = false;
+    for (GridEdge edge : {GridEdge::kTop, GridEdge::kBottom, GridEdge::kLeft, GridEdge::kRight}) {
+      const auto lines = LinesFrom(grid, edge);
+      std::vector<Eigen::Vector2d> beyond = Beyond(lines);
+      // Every point a junction, not just most: a line that runs partly off the pattern
+      // (a room's corner, the board) would steer the next extrapolation off it.
+      const std::vector<int> junctions = JunctionsBeyond(grey, lines, beyond, threshold);
+      if (std::count(junctions.begin(), junctions.end(), 1) != static_cast<int>(junctions.size())) continue;
+      double step_px = HUGE_VAL;
+      for (size_t i = 0; i < beyond.size(); ++i) step_px = std::min(step_px, (beyond[i] - lines[0][i]).norm());
+      std::vector<cv::Point2f> points;
+      for (const Eigen::Vector2d& p : beyond) points.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+      const int half_window = std::max(2, static_cast<int>(0.3 * step_px));
+      bool inside = true;
+      for (const cv::Point2f& p : points)
+        inside = inside && p.x >= half_window + 1 && p.y >= half_window + 1 && p.x < grey.cols - half_window - 2 &&
+                 p.y < grey.rows - half_window - 2;
+      if (!inside) continue;  // the pattern runs off the image: masking what is inside is enough
+      cv::cornerSubPix(grey, points, cv::Size(half_window, half_window), cv::Size(-1, -1),
+                       cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 20, 0.05));
+      bool on_junctions = true;
+      for (size_t i = 0; i < beyond.size(); ++i) {
+        const Eigen::Vector2d refined(points[i].x, points[i].y);
+        on_junctions = on_junctions && (refined - beyond[i]).norm() < 0.25 * step_px;
+        beyond[i] = refined;
+      }
+      if (!on_junctions) continue;
+      grid = Extended(grid, edge, beyond);
+      grew = true;
+    }
+    if (!grew) break;
+  }
+  return grid;
+}
+
+// Fills the grid's cells, extended one step on every side and dilated by 2 px (the blurred
+// edges), with their mean grey: the next search cannot complete a grid there, and no new
+// strong edges are made inside.
+void MaskGrid(const CheckerGrid& grid, cv::Mat* image) {
+  CheckerGrid extended = grid;
+  for (GridEdge edge : {GridEdge::kTop, GridEdge::kBottom, GridEdge::kLeft, GridEdge::kRight})
+    extended = Extended(extended, edge, Beyond(LinesFrom(extended, edge)));
+  cv::Mat mask = cv::Mat::zeros(image->size(), CV_8U);
+  for (int r = 0; r + 1 < extended.rows; ++r)
+    for (int c = 0; c + 1 < extended.cols; ++c) {
+      std::array<cv::Point, 4> quad;
+      const Eigen::Vector2d* cell[4] = {&extended.at(r, c), &extended.at(r, c + 1), &extended.at(r + 1, c + 1),
+                                        &extended.at(r + 1, c)};
+      for (int k = 0; k < 4; ++k) quad[k] = cv::Point(cvRound(cell[k]->x()), cvRound(cell[k]->y()));
+      cv::fillConvexPoly(mask, quad.data(), 4, cv::Scalar(255));
+    }
+  cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
+  image->setTo(cv::mean(*image, mask), mask);
+}
+
+}  // namespace
+
+const char* GridEdgeName(GridEdge edge) {
+  switch (edge) {
+    case GridEdge::kTop:
+      return "first row";
+    case GridEdge::kBottom:
+      return "last row";
+    case GridEdge::kLeft:
+      return "first column";
+    case GridEdge::kRight:
+      return "last column";
+  }
+  return "?";
+}
+
+double XJunctionScore(const cv::Mat& grey, const Eigen::Vector2d& point_px, const Eigen::Vector2d& step_a_px,
+                      const Eigen::Vector2d& step_b_px) {
+  CV_Assert(grey.type() == CV_8UC1);
+  // Quadrant k lies at signs (sa, sb) = (+,+), (-,+), (-,-), (+,-): cyclic around the point.
+  constexpr int kSigns[4][2] = {{1, 1}, {-1, 1}, {-1, -1}, {1, -1}};
+  constexpr double kOffsets[3] = {0.15, 0.25, 0.35};  // fractions of a step: clear of the grid lines
+  std::array<double, 4> quadrant;
+  for (int k = 0; k < 4; ++k) {
+    std::array<double, 9> samples;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        const Eigen::Vector2d at =
+            point_px + kSigns[k][0] * kOffsets[i] * step_a_px + kSigns[k][1] * kOffsets[j] * step_b_px;
+        samples[3 * i + j] = Bilinear<uchar>(grey, at.x(), at.y());
+        if (std::isnan(samples[3 * i + j])) return NAN;
+      }
+    quadrant[k] = Mean(samples);
+  }
+  return std::max(std::min(quadrant[0], quadrant[2]) - std::max(quadrant[1], quadrant[3]),
+                  std::min(quadrant[1], quadrant[3]) - std::max(quadrant[0], quadrant[2]));
+}
+
+bool CheckerboardCandidateOptions::Check(std::string* error) const {
+  if (max_candidates < 1) return *error = "max_candidates must be >= 1", false;
+  if (!(continuing_fraction > 0.0 && continuing_fraction <= 1.0))
+    return *error = "continuing_fraction must be in (0, 1]", false;
+  if (!(junction_contrast_fraction > 0.0 && junction_contrast_fraction < 1.0))
+    return *error = "junction_contrast_fraction must be in (0, 1)", false;
+  return true;
+}
+
+double GridContrast(const cv::Mat& grey, const CheckerGrid& grid) {
+  std::vector<double> scores;
+  for (int r = 0; r < grid.rows; ++r) {
+    std::vector<Eigen::Vector2d> row, column;
+    for (int c = 0; c < grid.cols; ++c) row.push_back(grid.at(r, c));
+    for (int c = 0; c < grid.cols; ++c) {
+      column.clear();
+      for (int k = 0; k < grid.rows; ++k) column.push_back(grid.at(k, c));
+      const double score = XJunctionScore(grey, grid.at(r, c), AlongStep(row, c), AlongStep(column, r));
+      if (!std::isnan(score)) scores.push_back(score);
+    }
+  }
+  if (scores.empty()) return 0.0;
+  std::nth_element(scores.begin(), scores.begin() + scores.size() / 2, scores.end());
+  return scores[scores.size() / 2];
+}
+
+std::vector<GridContinuation> GridContinuations(const cv::Mat& grey, const CheckerGrid& grid,
+                                                const CheckerboardCandidateOptions& options) {
+  return Continuations(grey, grid, options.junction_contrast_fraction * GridContrast(grey, grid));
+}
+
+std::vector<CheckerboardCandidate> FindCheckerboardCandidates(const cv::Mat& grey, cv::Size pattern,
+                                                              const CheckerboardCandidateOptions& options) {
+  CV_Assert(grey.type() == CV_8UC1);
+  if (std::string error; !options.Check(&error))
+    throw std::invalid_argument("checkerboard candidate options: " + error);
+  // Extrapolating across an edge needs a second line.
+  if (pattern.width < 2 || pattern.height < 2)
+    throw std::invalid_argument("checkerboard pattern under 2 x 2 inner corners");
+  std::vector<CheckerboardCandidate> candidates;
+  cv::Mat search;
+  if (options.mirrored)
+    cv::flip(grey, search, 1);
+  else
+    search = grey.clone();
+  // The searched image's pixels <-> the given image's: a flip maps column x to cols - 1 - x.
+  auto to_grey = [&](Eigen::Vector2d p) {
+    if (options.mirrored) p.x() = grey.cols - 1 - p.x();
+    return p;
+  };
+  for (int k = 0; k < options.max_candidates; ++k) {
+    std::vector<cv::Point2f> found;
+    // findChessboardCornersSB draws from the thread's cv::theRNG(): the same image gives
+    // another grid, or none, after other detections ran in the thread. A fresh thread's
+    // state for every search makes detection depend on the image alone; the caller's
+    // state is put back.
+    const uint64_t caller_rng = cv::theRNG().state;
+    cv::theRNG().state = cv::RNG().state;
+    const bool ok =
+        cv::findChessboardCornersSB(search, pattern, found, cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY);
+    cv::theRNG().state = caller_rng;
+    if (!ok) break;
+    CheckerboardCandidate candidate;
+    candidate.grid.rows = pattern.height;
+    candidate.grid.cols = pattern.width;
+    for (const cv::Point2f& p : found) candidate.grid.corners_px.push_back(to_grey(Eigen::Vector2d(p.x, p.y)));
+    // Measured on the image itself: the mask of earlier candidates must not change them.
+    candidate.contrast = GridContrast(grey, candidate.grid);
+    const double threshold = options.junction_contrast_fraction * candidate.contrast;
+    std::vector<std::string> continuing;
+    for (const GridContinuation& edge : Continuations(grey, candidate.grid, threshold))
+      if (Continues(edge, options.continuing_fraction)) continuing.push_back(edge.facing);
+    candidate.accepted = continuing.empty();
+    CheckerGrid masked = candidate.grid;
+    if (!candidate.accepted) {
+      std::string where = continuing[0];
+      for (size_t i = 1; i < continuing.size(); ++i)
+        where += (i + 1 == continuing.size() ? " and " : ", ") + continuing[i];
+      candidate.refusal = "a patch of a larger checker pattern (the grid continues past its " + where +
+                          (continuing.size() > 1 ? " edges)" : " edge)");
+      masked = GrowPattern(grey, candidate.grid, threshold);
+    }
+    for (Eigen::Vector2d& p : masked.corners_px) p = to_grey(p);  // the flip is its own inverse
+    MaskGrid(masked, &search);
+    const bool accepted = candidate.accepted;
+    candidates.push_back(std::move(candidate));
+    if (accepted && options.stop_at_first_accepted) break;
+  }
+  return candidates;
+}
+
+}  // namespace omnical

@@ -1,0 +1,136 @@
+#include "calib/predicted_error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace omnical {
+namespace {
+
+double ParameterValue(const Sensor& sensor, const std::string& name, double fallback) {
+  for (const ParameterEstimate& p : SensorParameters(sensor))
+    if (p.name == name) return p.value;
+  return fallback;
+}
+
+// The camera-frame points at distance_mm along the pixels' rays (NaN where unprojectable).
+Eigen::Matrix3Xd PointsAt(const Sensor& sensor, const std::vector<Eigen::Vector2d>& pixels, double distance_mm) {
+  Eigen::Matrix2Xd grid(2, pixels.size());
+  for (size_t k = 0; k < pixels.size(); ++k) grid.col(k) = pixels[k];
+  Eigen::Matrix3Xd origins, directions;
+  std::vector<ProjectionStatus> statuses;
+  sensor.UnprojectBatch(grid, &origins, &directions, &statuses);
+  Eigen::Matrix3Xd points(3, pixels.size());
+  for (size_t k = 0; k < pixels.size(); ++k)
+    points.col(k) = statuses[k] == ProjectionStatus::kOk ? Eigen::Vector3d(origins.col(k) + distance_mm * directions.col(k))
+                                                          : Eigen::Vector3d::Constant(NAN);
+  return points;
+}
+
+Eigen::Matrix2Xd Projected(const Sensor& sensor, const Eigen::Matrix3Xd& points) {
+  Eigen::Matrix2Xd pixels;
+  std::vector<ProjectionStatus> statuses;
+  sensor.ProjectBatch(points, &pixels, &statuses);
+  for (size_t k = 0; k < statuses.size(); ++k)
+    if (statuses[k] != ProjectionStatus::kOk) pixels.col(k).setConstant(NAN);
+  return pixels;
+}
+
+}  // namespace
+
+void MedianAndMax(std::vector<double> values, double* median, double* max) {
+  values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }), values.end());
+  if (values.empty()) {
+    *median = *max = NAN;
+    return;
+  }
+  *max = *std::max_element(values.begin(), values.end());
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  *median = values[values.size() / 2];
+}
+
+ObservedField FieldOfCorners(const Sensor& sensor, const DetectionSet& detections) {
+  ObservedField field;
+  field.centre_px = Eigen::Vector2d(ParameterValue(sensor, "cx_px", 0.5 * (sensor.image_width_px() - 1)),
+                                    ParameterValue(sensor, "cy_px", 0.5 * (sensor.image_height_px() - 1)));
+  field.inner_radius_px = HUGE_VAL;
+  for (const ImageDetections& image : detections.images)
+    for (const CornerObservation& c : image.corners) {
+      const double r = (c.pixel - field.centre_px).norm();
+      field.inner_radius_px = std::min(field.inner_radius_px, r);
+      field.outer_radius_px = std::max(field.outer_radius_px, r);
+    }
+  if (!std::isfinite(field.inner_radius_px)) field.inner_radius_px = 0.0;
+  return field;
+}
+
+std::vector<Eigen::Vector2d> FieldPixels(const Sensor& sensor, const ObservedField& field, double step_px) {
+  std::vector<Eigen::Vector2d> pixels;
+  for (double v = 0.5 * step_px; v < sensor.image_height_px(); v += step_px)
+    for (double u = 0.5 * step_px; u < sensor.image_width_px(); u += step_px) {
+      const Eigen::Vector2d pixel(u, v);
+      const double r = (pixel - field.centre_px).norm();
+      Eigen::Vector3d origin, direction;
+      if (r >= field.inner_radius_px && r <= field.outer_radius_px &&
+          sensor.Unproject(pixel, &origin, &direction) == ProjectionStatus::kOk)
+        pixels.push_back(pixel);
+    }
+  return pixels;
+}
+
+std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const FitResult& fit,
+                                                   const std::vector<Eigen::Vector2d>& pixels,
+                                                   const std::vector<double>& distances_mm) {
+  if (!fit.covariance_ok || fit.covariance.rows() != static_cast<int>(fit.covariance_names.size()))
+    throw std::invalid_argument("PredictProjectionError: the fit has no covariance");
+  const std::vector<ParameterEstimate> named = SensorParameters(sensor);
+  std::vector<double> values;
+  for (const ParameterEstimate& p : named) values.push_back(p.value);
+  // Index of each covariance row among the sensor's parameters.
+  std::vector<size_t> index;
+  for (const std::string& name : fit.covariance_names) {
+    const auto found = std::find_if(named.begin(), named.end(), [&](const ParameterEstimate& p) { return p.name == name; });
+    if (found == named.end()) throw std::invalid_argument("PredictProjectionError: unknown parameter " + name);
+    index.push_back(static_cast<size_t>(found - named.begin()));
+  }
+  const int count = static_cast<int>(index.size());
+  std::vector<PredictedError> maps;
+  for (double distance_mm : distances_mm) {
+    const Eigen::Matrix3Xd points = PointsAt(sensor, pixels, distance_mm);
+    // d pixel / d parameter by central differences, a tenth of a std each way: linear
+    // there (the solvers' 1e-10 px is far below the ~1e-3 px differences).
+    std::vector<Eigen::Matrix2Xd> derivative(count);
+    for (int k = 0; k < count; ++k) {
+      const double step = std::max(0.1 * std::sqrt(std::max(0.0, fit.covariance(k, k))), 1e-9 * (1.0 + std::abs(values[index[k]])));
+      std::vector<double> plus = values, minus = values;
+      plus[index[k]] += step;
+      minus[index[k]] -= step;
+      derivative[k] = (Projected(SensorWithParameters(sensor, plus), points) -
+                       Projected(SensorWithParameters(sensor, minus), points)) / (2.0 * step);
+    }
+    PredictedError map;
+    map.distance_mm = distance_mm;
+    map.pixels = pixels;
+    map.std_px.resize(pixels.size());
+    for (size_t p = 0; p < pixels.size(); ++p) {
+      Eigen::Matrix2Xd jacobian(2, count);
+      for (int k = 0; k < count; ++k) jacobian.col(k) = derivative[k].col(p);
+      const double variance = (jacobian * fit.covariance * jacobian.transpose()).trace();
+      map.std_px[p] = jacobian.allFinite() ? std::sqrt(std::max(0.0, variance)) : NAN;
+    }
+    MedianAndMax(map.std_px, &map.median_px, &map.max_px);
+    maps.push_back(std::move(map));
+  }
+  return maps;
+}
+
+std::vector<double> ProjectionDisplacement(const Sensor& reference, const Sensor& other,
+                                           const std::vector<Eigen::Vector2d>& pixels, double distance_mm) {
+  const Eigen::Matrix2Xd moved = Projected(other, PointsAt(reference, pixels, distance_mm));
+  const Eigen::Matrix2Xd back = Projected(reference, PointsAt(reference, pixels, distance_mm));
+  std::vector<double> displacement(pixels.size());
+  for (size_t k = 0; k < pixels.size(); ++k) displacement[k] = (moved.col(k) - back.col(k)).norm();
+  return displacement;
+}
+
+}  // namespace omnical

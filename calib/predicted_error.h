@@ -1,0 +1,59 @@
+// How far a calibrated sensor's projection may be off at a distance the user cares about:
+// the fit's covariance of the sensor parameters (poses marginalised, priors included)
+// pushed through the projection of points at that distance, over the part of the image
+// the calibration observed.
+//
+// The point of a pixel at distance D lies D mm along the pixel's ray from its reflection
+// point (the seed paper's n = D / rim radius; D = kInfinityMm for infinity) and is held
+// fixed in the camera frame while the parameters vary. Per point the predicted error is
+// sqrt(trace(J C J^T)), J = d pixel / d parameters (central differences), C the
+// covariance: the RMS length of the 2-D error vector, the same per-corner definition as
+// omnical's reprojection RMS (per coordinate it is smaller by sqrt 2).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "calib/bundle_fit.h"
+#include "calib/detections.h"
+#include "model/sensor.h"
+
+namespace omnical {
+
+inline constexpr double kInfinityMm = 1e8;
+
+// An annulus around the principal point: the radii the calibration's corners cover, all
+// round (the mirror is rotationally symmetric; a user's panorama uses every azimuth).
+struct ObservedField {
+  Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
+  double inner_radius_px = 0.0, outer_radius_px = 0.0;
+};
+ObservedField FieldOfCorners(const Sensor& sensor, const DetectionSet& detections);
+
+// Pixels on a square grid (step_px apart) inside the field and seen through the sensor.
+std::vector<Eigen::Vector2d> FieldPixels(const Sensor& sensor, const ObservedField& field, double step_px);
+
+struct PredictedError {
+  double distance_mm = 0.0;
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<double> std_px;  // per pixel (NaN where the point does not project)
+  double median_px = 0.0, max_px = 0.0;
+};
+
+// One map per distance. `fit` supplies the parameters and covariance (FitResult's
+// covariance_names order); throws std::invalid_argument without a covariance.
+std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const FitResult& fit,
+                                                   const std::vector<Eigen::Vector2d>& pixels,
+                                                   const std::vector<double>& distances_mm);
+
+// |pixel of `other` - pixel| for the point at distance_mm along each pixel's ray through
+// `reference`: how far another sensor (a calibration vs the truth, or two calibrations)
+// misplaces the same objects. NaN where either does not project.
+std::vector<double> ProjectionDisplacement(const Sensor& reference, const Sensor& other,
+                                           const std::vector<Eigen::Vector2d>& pixels, double distance_mm);
+
+// Median and maximum of the finite values.
+void MedianAndMax(std::vector<double> values, double* median, double* max);
+
+}  // namespace omnical
