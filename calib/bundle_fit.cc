@@ -1,5 +1,7 @@
 #include "calib/bundle_fit.h"
 
+#include "model/input_error.h"
+
 #include <ceres/ceres.h>
 
 #include <Eigen/SVD>
@@ -8,8 +10,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 namespace omnical {
 namespace {
@@ -153,8 +157,25 @@ std::string FormatNumber(double value) {
 }
 std::string FormatPx(double value) { return FormatNumber(value) + " px"; }
 
+}  // namespace
+
+std::map<std::string, double> ExpandTolerances(const std::map<std::string, double>& tolerances) {
+  std::map<std::string, double> expanded;
+  for (const auto& [key, tolerance] : tolerances)  // pairs first: a component named on its own wins
+    if (ToleranceTargets(key).size() > 1)
+      for (const std::string& name : ToleranceTargets(key)) expanded[name] = tolerance;
+  for (const auto& [key, tolerance] : tolerances)
+    if (ToleranceTargets(key).size() == 1) expanded[key] = tolerance;
+  return expanded;
+}
+
+namespace {
+
 // A parameter this many tolerances from its design is reported (3: a 0.3 % event).
 constexpr double kToleranceConflict = 3.0;
+
+// Fewer views than this cannot separate the sensor from the poses (the CLI asks as many).
+constexpr size_t kMinViews = 3;
 
 // A view's corners fewer than this leave its pose (6 unknowns) barely determined.
 constexpr size_t kMinCornersPerView = 4;
@@ -287,17 +308,39 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
   const std::map<const double*, int> block_sizes = {{lens.data(), static_cast<int>(lens.size())}, {&m_mm, 1}, {tilt, 2},
                                                     {decenter, 2}, {shape.data(), static_cast<int>(shape.size())}};
   double prior_noise_px = 1.0;  // the corner noise the priors are scaled by; updated below
-  std::vector<Prior> priors;
-  for (const auto& [key, tolerance] : options.tolerances)
-    for (const std::string& name : ToleranceTargets(key)) {
-      const auto found = named.find(name);
-      if (found == named.end()) continue;  // CheckFor names it; unreachable for checked options
-      double* block = found->second.first;
-      const auto [index, scale] = found->second.second;
-      priors.push_back({name, block, index, block[index], tolerance / scale, scale});
-      problem.AddResidualBlock(new PriorCost(block_sizes.at(block), index, block[index], tolerance / scale, &prior_noise_px),
-                               nullptr, block);
+  std::map<std::string, double> tolerance_of = ExpandTolerances(options.tolerances);
+  // A sphere's tilt is its gauge (held by default): the fitted decenter is then the offset
+  // of its centre, decenter + A (cos tx sin ty, -sin tx), which the design's tilt error
+  // moves too. A tilt tolerance therefore widens the decenter's: sigma_x^2 + (A sigma_ty)^2.
+  if constexpr (std::is_same_v<ProfileD, SphereProfile<double>>) {
+    if (options.fixed.count("tilt")) {
+      const double radius_mm = guess.mirror.radius_of_curvature_mm;
+      for (const auto& [tilt_name, decenter_name] : {std::pair<std::string, std::string>{"tilt_y_deg", "decenter_x_mm"},
+                                                     {"tilt_x_deg", "decenter_y_mm"}}) {
+        const auto tilt_tolerance = tolerance_of.find(tilt_name);
+        if (tilt_tolerance == tolerance_of.end()) continue;
+        const double widened = radius_mm * tilt_tolerance->second / kDeg;
+        double& decenter_tolerance = tolerance_of[decenter_name];  // 0 if none was given
+        decenter_tolerance = std::hypot(decenter_tolerance, widened);
+        result.tolerance_notes.push_back(tilt_name + "'s tolerance widens " + decenter_name + "'s to " +
+                                         FormatNumber(decenter_tolerance) +
+                                         " mm (a sphere's tilt is held: its centre is what the data see)");
+        tolerance_of.erase(tilt_tolerance);
+      }
     }
+  }
+  std::vector<Prior> priors;
+  for (const auto& [name, tolerance] : tolerance_of) {
+    const auto found = named.find(name);
+    if (found == named.end()) continue;  // FitSensor checked the names
+    double* block = found->second.first;
+    const auto [index, scale] = found->second.second;
+    const auto design = options.design.find(name);
+    const double centre = design != options.design.end() ? design->second / scale : block[index];
+    priors.push_back({name, block, index, centre, tolerance / scale, scale});
+    problem.AddResidualBlock(new PriorCost(block_sizes.at(block), index, centre, tolerance / scale, &prior_noise_px), nullptr,
+                             block);
+  }
 
   // Which lens entries are held: all, the scale (fx, fy or the orthographic scale), and in
   // stage 1 the radial distortion (k1, k2), which otherwise absorbs the error of a poor
@@ -438,6 +481,12 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
                            "): not the board the other views show (a false, bent or wrongly sized board)");
       }
     }
+    const size_t fitted_views = std::count(result.view_left_out.begin(), result.view_left_out.end(), "");
+    if (fitted_views < kMinViews) {
+      result.solver_report = std::to_string(fitted_views) + " views are left after the outlier rule (" +
+                             std::to_string(kMinViews) + " needed): the corners do not show one board through one sensor";
+      return result;
+    }
     loss->Reset(new ceres::HuberLoss(options.robust_loss_px), ceres::TAKE_OWNERSHIP);
     prior_noise_px = std::max(1e-3, robust_sigma(residual_norms()));
     ceres::Solve(solver, &problem, &summary);
@@ -478,6 +527,7 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
   // A parameter that ends many tolerances from its design: the guess, the tolerance or the
   // data is wrong (a prior that strong against the data is no longer a weak one).
   for (const Prior& prior : priors) {
+    if (problem.IsParameterBlockConstant(prior.block)) continue;  // held: noted below
     const double moved = std::abs(prior.block[prior.index] - prior.design) / prior.tolerance;
     if (moved > kToleranceConflict)
       result.tolerance_conflicts.push_back(prior.name + " ended " + FormatNumber(moved) + " tolerances (" +
@@ -489,7 +539,8 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
   std::vector<int> view_count(views, 0);
   for (const Residual& r : residuals) {
     double value[2] = {NAN, NAN};
-    if (!(*r.functor)(r.blocks.data(), value)) continue;
+    // A left-out view has no fitted pose: its corners stay NaN ("dropped" in reports).
+    if (!result.view_left_out[r.view].empty() || !(*r.functor)(r.blocks.data(), value)) continue;
     const Eigen::Vector2d e(value[0], value[1]);
     result.residuals_px[r.view][r.index] = e;
     if (r.outlier) continue;
@@ -523,6 +574,11 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
       column += tangent;
     }
   }
+  for (const Prior& prior : priors) {
+    const auto found = columns.find(prior.block);
+    if (found == columns.end() || found->second[prior.index] < 0)
+      result.tolerance_notes.push_back("the tolerance on " + prior.name + " is not used: the parameter is held");
+  }
   Eigen::MatrixXd covariance_internal;
   if (options.compute_covariance) {
     std::vector<ceres::ResidualBlockId> data_blocks;
@@ -533,20 +589,21 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
     evaluate.residual_blocks = data_blocks;
     evaluate.apply_loss_function = false;
     ceres::CRSMatrix crs;
-    problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
+    const bool evaluated = !data_blocks.empty() && problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs);
     std::vector<std::pair<int, double>> prior_rows;  // column, 1 / tolerance
     for (const Prior& prior : priors) {
       const auto found = columns.find(prior.block);
       if (found != columns.end() && found->second[prior.index] >= 0)
         prior_rows.push_back({found->second[prior.index], 1.0 / prior.tolerance});
     }
+    if (!evaluated) crs.num_rows = crs.num_cols = 0, prior_rows.clear();
     Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(crs.num_rows + prior_rows.size(), crs.num_cols);
     const double inverse_sigma = 1.0 / std::max(result.sigma_px, 1e-12);
     for (int r = 0; r < crs.num_rows; ++r)
       for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) jacobian(r, crs.cols[k]) = crs.values[k] * inverse_sigma;
     for (size_t p = 0; p < prior_rows.size(); ++p) jacobian(crs.num_rows + p, prior_rows[p].first) = prior_rows[p].second;
     Eigen::VectorXd column_scale = jacobian.colwise().norm().transpose();
-    if ((column_scale.array() > 0.0).all() && jacobian.rows() >= jacobian.cols()) {
+    if (evaluated && (column_scale.array() > 0.0).all() && jacobian.rows() >= jacobian.cols()) {
       const Eigen::MatrixXd scaled = jacobian * column_scale.cwiseInverse().asDiagonal();
       const Eigen::JacobiSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeThinV);
       const Eigen::VectorXd& singular = svd.singularValues();
@@ -664,6 +721,15 @@ std::vector<ParameterEstimate> SensorParameters(const Sensor& sensor) {
   return parameters;
 }
 
+Sensor SensorWithWiderRim(const Sensor& sensor, double factor) {
+  return std::visit(
+      [&](auto model) {
+        model.rim_radius_mm = std::min(factor * model.rim_radius_mm, 0.99 * model.mirror.MaxRadiusMm());
+        return Sensor(model);
+      },
+      sensor.model());
+}
+
 Sensor SensorWithParameters(const Sensor& sensor, const std::vector<double>& values) {
   return std::visit(
       [&](const auto& model) {
@@ -711,6 +777,8 @@ std::string FitOptions::CheckFor(const Sensor& sensor) const {
   std::set<std::string> names;
   std::string list;
   for (const ParameterEstimate& p : SensorParameters(sensor)) names.insert(p.name), list += p.name + ", ";
+  for (const auto& [name, value] : design)
+    if (!names.count(name) || !std::isfinite(value)) return "design." + name + ": not a parameter of this sensor, or not finite";
   for (const auto& [key, tolerance] : tolerances) {
     for (const std::string& name : ToleranceTargets(key))
       if (!names.count(name))
@@ -769,6 +837,9 @@ bool InitialTargetPose(const Sensor& sensor, const CalibrationTarget& target, co
 
 FitResult FitSensor(const Sensor& guess, const CalibrationTarget& target, const DetectionSet& detections,
                     const std::vector<TargetPose>& initial_poses, const FitOptions& options) {
+  if (const std::string why = options.CheckFor(guess); !why.empty()) throw InputError(why);
+  if (initial_poses.size() != detections.images.size())
+    throw std::invalid_argument("FitSensor: one initial pose per view is needed");
   return std::visit([&](const auto& model) { return FitModel(model, target, detections, initial_poses, options); },
                     guess.model());
 }

@@ -51,8 +51,13 @@ struct FitOptions {
   // A_mm, ...) or a pair: tilt_deg, decenter_mm, principal_point_px, focal_px. They pull
   // the fit towards the design (a weak prior residual: the wrong basins of the camera
   // rotation / decenter / distortion valley lie many tolerances away) and enter the
-  // covariance. A tolerance on a held parameter is ignored.
+  // covariance. A tolerance on a held parameter is ignored (FitResult::tolerance_notes
+  // says so); on a sphere with its tilt held, a tilt tolerance widens the decenter's.
   std::map<std::string, double> tolerances;
+  // The design values the tolerances are centred on, by parameter name (reported units);
+  // a parameter not named here is centred on the guess's value. A pipeline that fits
+  // several times (a second detection pass from the first fit) keeps the user's design.
+  std::map<std::string, double> design;
 
   // The gauge-fixing defaults for a sensor (see above).
   static FitOptions DefaultsFor(const Sensor& sensor);
@@ -101,6 +106,9 @@ struct FitResult {
   std::vector<std::string> covariance_names;
   // Parameters that ended more than 3 tolerances from their design values, one line each.
   std::vector<std::string> tolerance_conflicts;
+  // How the tolerances were applied where that is not as given (ignored on a held
+  // parameter, folded into another), one line each.
+  std::vector<std::string> tolerance_notes;
   double guess_rim_radius_mm = 0.0;  // the guess's rim, for comparison with the fitted sensor's
   // Corner residuals' standard deviation per coordinate (px), from the fit's RMS and its
   // degrees of freedom: what the covariance is scaled by.
@@ -109,6 +117,14 @@ struct FitResult {
 
 // The sensor's parameters in FitResult's naming and units (values only, std 0).
 std::vector<ParameterEstimate> SensorParameters(const Sensor& sensor);
+// Tolerances per parameter name: the pairs (tilt_deg, decenter_mm, principal_point_px,
+// focal_px) expanded to their components, a component named on its own winning.
+std::map<std::string, double> ExpandTolerances(const std::map<std::string, double>& tolerances);
+
+// The sensor with its rim `factor` times as wide, within the profile's domain: for
+// evaluating corners the fit let stray past the rim, or parameter steps near it.
+Sensor SensorWithWiderRim(const Sensor& sensor, double factor);
+
 // The sensor with its parameters set to `values` (SensorParameters' order and units).
 Sensor SensorWithParameters(const Sensor& sensor, const std::vector<double>& values);
 

@@ -38,10 +38,11 @@ struct DetectionStats {
 ImageDetections DetectAprilGrid(const CalibrationTarget& target, const cv::Mat& grey, DetectionStats* stats = nullptr,
                                 bool mirrored = true);
 
-// The checkerboard's inner corners, all or none. Every candidate grid in the image is
-// considered and one that is a patch of a larger checker pattern (tiles, a checked floor)
-// is refused (calib/checkerboard_candidates.h); of the accepted ones, the one with the most
-// contrast (printed ink on paper). `candidates` (optional) receives every candidate with
+// The checkerboard's inner corners, all or none. Candidate grids are searched for until
+// one is accepted (up to three searches, calib/checkerboard_candidates.h), and one that is
+// a patch of a larger checker pattern (tiles, a checked floor) is refused; a grid that is
+// not, but shows another board than the other views (a wrongly sized decoy), is for the
+// fit's board checks (calib/board_scale.h). `candidates` (optional) receives every candidate with
 // its refusal reason, for the caller's warnings. Throws std::invalid_argument for another
 // target type.
 ImageDetections DetectCheckerboard(const CalibrationTarget& target, const cv::Mat& grey,

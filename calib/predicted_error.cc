@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 namespace omnical {
@@ -49,6 +50,29 @@ void MedianAndMax(std::vector<double> values, double* median, double* max) {
   *median = values[values.size() / 2];
 }
 
+double MedianCornerDistanceMm(const Sensor& sensor, const CalibrationTarget& target, const DetectionSet& detections,
+                              const FitResult& fit) {
+  std::map<int, Eigen::Vector3d> points;
+  for (const TargetCorner& c : target.corners()) points[c.id] = c.point_in_target;
+  std::vector<double> distances;
+  for (size_t v = 0; v < detections.images.size() && v < fit.poses.size(); ++v) {
+    if (v < fit.view_left_out.size() && !fit.view_left_out[v].empty()) continue;
+    for (const CornerObservation& c : detections.images[v].corners) {
+      const auto point = points.find(c.id);
+      if (point == points.end()) continue;
+      const Eigen::Vector3d in_camera =
+          fit.poses[v].camera_from_target_rotation * point->second + fit.poses[v].camera_from_target_translation_mm;
+      Eigen::Vector3d mirror_point;
+      if (std::visit([&](const auto& m) { return m.ReflectionPoint(in_camera, &mirror_point, &sensor.cache()); },
+                     sensor.model()) == ProjectionStatus::kOk)
+        distances.push_back((in_camera - mirror_point).norm());
+    }
+  }
+  double median = NAN, farthest = NAN;
+  MedianAndMax(distances, &median, &farthest);
+  return median;
+}
+
 ObservedField FieldOfCorners(const Sensor& sensor, const DetectionSet& detections) {
   ObservedField field;
   field.centre_px = Eigen::Vector2d(ParameterValue(sensor, "cx_px", 0.5 * (sensor.image_width_px() - 1)),
@@ -83,6 +107,9 @@ std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const F
                                                    const std::vector<double>& distances_mm) {
   if (!fit.covariance_ok || fit.covariance.rows() != static_cast<int>(fit.covariance_names.size()))
     throw std::invalid_argument("PredictProjectionError: the fit has no covariance");
+  // 5 % wider: a parameter step must not push the outermost field pixels' reflections
+  // past the rim, where they would drop out exactly where the error is largest.
+  const Sensor wide = SensorWithWiderRim(sensor, 1.05);
   const std::vector<ParameterEstimate> named = SensorParameters(sensor);
   std::vector<double> values;
   for (const ParameterEstimate& p : named) values.push_back(p.value);
@@ -105,8 +132,8 @@ std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const F
       std::vector<double> plus = values, minus = values;
       plus[index[k]] += step;
       minus[index[k]] -= step;
-      derivative[k] = (Projected(SensorWithParameters(sensor, plus), points) -
-                       Projected(SensorWithParameters(sensor, minus), points)) / (2.0 * step);
+      derivative[k] = (Projected(SensorWithParameters(wide, plus), points) -
+                       Projected(SensorWithParameters(wide, minus), points)) / (2.0 * step);
     }
     PredictedError map;
     map.distance_mm = distance_mm;
@@ -117,6 +144,7 @@ std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const F
       for (int k = 0; k < count; ++k) jacobian.col(k) = derivative[k].col(p);
       const double variance = (jacobian * fit.covariance * jacobian.transpose()).trace();
       map.std_px[p] = jacobian.allFinite() ? std::sqrt(std::max(0.0, variance)) : NAN;
+      map.unpredicted += !std::isfinite(map.std_px[p]);
     }
     MedianAndMax(map.std_px, &map.median_px, &map.max_px);
     maps.push_back(std::move(map));

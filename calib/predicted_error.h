@@ -17,6 +17,7 @@
 
 #include "calib/bundle_fit.h"
 #include "calib/detections.h"
+#include "calib/target.h"
 #include "model/sensor.h"
 
 namespace omnical {
@@ -38,7 +39,8 @@ struct PredictedError {
   double distance_mm = 0.0;
   std::vector<Eigen::Vector2d> pixels;
   std::vector<double> std_px;  // per pixel (NaN where the point does not project)
-  double median_px = 0.0, max_px = 0.0;
+  double median_px = 0.0, max_px = 0.0;  // over the predicted pixels
+  int unpredicted = 0;                    // pixels whose point did not project
 };
 
 // One map per distance. `fit` supplies the parameters and covariance (FitResult's
@@ -52,6 +54,12 @@ std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const F
 // misplaces the same objects. NaN where either does not project.
 std::vector<double> ProjectionDisplacement(const Sensor& reference, const Sensor& other,
                                            const std::vector<Eigen::Vector2d>& pixels, double distance_mm);
+
+// The median distance (mm) of the fitted views' corners from their reflection points,
+// through the fitted sensor and poses: the default distance to predict the error at.
+// NaN if no corner projects.
+double MedianCornerDistanceMm(const Sensor& sensor, const CalibrationTarget& target, const DetectionSet& detections,
+                              const FitResult& fit);
 
 // Median and maximum of the finite values.
 void MedianAndMax(std::vector<double> values, double* median, double* max);

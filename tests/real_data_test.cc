@@ -12,6 +12,7 @@
 #include <map>
 #include <sstream>
 
+#include "calib/board_scale.h"
 #include "calib/bundle_fit.h"
 #include "calib/detect.h"
 #include "calib/initial_sensor.h"
@@ -91,6 +92,11 @@ TEST(RealImages, MeiParabolicDetectsAndCalibrates) {
     for (size_t v = 0; v < fit.view_left_out.size(); ++v) EXPECT_EQ(fit.view_left_out[v], "") << profile << " view " << v;
     if (profile == "polynomial") {
       EXPECT_LT(fit.outliers, 0.04 * 480);
+      // Real boards are the target's size: none is refused as another board.
+      for (size_t v = 0; v < detections.images.size(); ++v) {
+        const BoardScale check = CheckBoardScale(*fit.sensor, board, detections.images[v], fit.poses[v], fit.sigma_px);
+        EXPECT_FALSE(check.refused) << detections.images[v].image << ": " << check.reason;
+      }
     }
     std::printf("%s: RMS %.3f px, %d outliers beyond %.2f px\n", profile.c_str(), fit.rms_px, fit.outliers,
                 fit.outlier_threshold_px);

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "calib/board_scale.h"
 #include "calib/bundle_fit.h"
 #include "calib/design_tolerances.h"
 #include "calib/initial_sensor.h"
@@ -269,18 +270,28 @@ void Run(const Options& options, const Context& context) {
   fit_options.robust_loss_px = options.loss_px;
   fit_options.max_iterations = options.max_iterations;
   if (const std::string why = fit_options.Check(); !why.empty()) throw InputError(why);
-  // Design tolerances: the guess file's, then --tolerance's (which win).
+  // Design tolerances: the guess file's, then --tolerance's (which win), per parameter.
+  std::vector<std::string> warnings;
   if (given) {
-    fit_options.tolerances = ReadDesignTolerances(options.sensor_path, *given);
+    fit_options.tolerances = ExpandTolerances(ReadDesignTolerances(options.sensor_path, *given));
     // Converted to another family: the old family's shape tolerances do not apply.
     for (auto it = fit_options.tolerances.begin(); it != fit_options.tolerances.end();) {
       FitOptions one;
       one.tolerances = {*it};
-      it = one.CheckFor(guess).empty() ? std::next(it) : fit_options.tolerances.erase(it);
+      if (one.CheckFor(guess).empty()) {
+        ++it;
+        continue;
+      }
+      warnings.push_back(options.sensor_path + ": the tolerance on " + it->first + " does not apply to a " +
+                         guess.profile_name() + " mirror and is not used");
+      it = fit_options.tolerances.erase(it);
     }
   }
-  for (const auto& [name, value] : ParseDesignTolerances(options.tolerance, "--tolerance")) fit_options.tolerances[name] = value;
+  for (const auto& [name, value] : ExpandTolerances(ParseDesignTolerances(options.tolerance, "--tolerance")))
+    fit_options.tolerances[name] = value;
   if (const std::string why = fit_options.CheckFor(guess); !why.empty()) throw InputError("--tolerance: " + why);
+  // The tolerances stay centred on the start's values through every pass.
+  for (const ParameterEstimate& p : SensorParameters(guess)) fit_options.design[p.name] = p.value;
 
   int unrefined = 0;
   UsableViews views = ViewsForFit(guess, target, FittableCorners(target, options.target_path, source, detections, &unrefined),
@@ -306,6 +317,31 @@ void Run(const Options& options, const Context& context) {
     fit = FitSensor(*refit_start, target, views.detections, views.poses, fit_options);
   }
   const Sensor& fit_start = refit_start ? *refit_start : guess;
+  // Boards of another size than the target (a decoy the detector accepted, e.g. a window
+  // of tiles that passed the continuation test) are refused through the fitted sensor and
+  // the fit is repeated without them (calib/board_scale.h).
+  if (fit.sensor) {
+    std::vector<size_t> refused;
+    for (size_t v = 0; v < views.detections.images.size(); ++v) {
+      if (!fit.view_left_out[v].empty()) continue;
+      const BoardScale check = CheckBoardScale(*fit.sensor, target, views.detections.images[v], fit.poses[v], fit.sigma_px);
+      if (!check.refused) continue;
+      warnings.push_back(views.detections.images[v].image + ": view left out: the board " + check.reason);
+      refused.push_back(v);
+    }
+    for (auto v = refused.rbegin(); v != refused.rend(); ++v) {
+      views.observations -= static_cast<int>(views.detections.images[*v].corners.size());
+      views.detections.images.erase(views.detections.images.begin() + *v);
+      views.poses.erase(views.poses.begin() + *v);
+    }
+    if (!refused.empty()) {
+      if (views.detections.images.size() < 3)
+        throw InputError(InputMessage(source, "images",
+                                      std::to_string(views.detections.images.size()) +
+                                          " views are left once the boards of another size are refused (need >= 3)"));
+      fit = FitSensor(fit_start, target, views.detections, views.poses, fit_options);
+    }
+  }
   const DetectionSet& usable = views.detections;
   const std::vector<TargetPose>& poses = views.poses;
   const int observations = views.observations;
@@ -354,7 +390,6 @@ void Run(const Options& options, const Context& context) {
       result["leave_one_out"][name] = {{"min", *lo}, {"max", *hi}, {"std", std::sqrt(square / values.size())}};
     }
   }
-  std::vector<std::string> warnings;
   if (!why_invalid.empty()) warnings.push_back("the fitted sensor fails validation: " + why_invalid);
   if (!fit.converged) warnings.push_back("the solver did not converge: " + fit.solver_report);
   if (!fit.covariance_ok) warnings.push_back("the parameters are not all determined by the data (a free gauge): fix one with --fix");
@@ -382,9 +417,10 @@ void Run(const Options& options, const Context& context) {
   const bool shape_free = std::any_of(fit.parameters.begin(), fit.parameters.end(),
                                       [&](const ParameterEstimate& p) { return !p.fixed && shape_parameter(p.name); });
   double nearest_mm = HUGE_VAL, farthest_mm = 0.0;
-  for (const TargetPose& pose : fit.poses) {
-    nearest_mm = std::min(nearest_mm, pose.camera_from_target_translation_mm.norm());
-    farthest_mm = std::max(farthest_mm, pose.camera_from_target_translation_mm.norm());
+  for (size_t v = 0; v < fit.poses.size(); ++v) {
+    if (!fit.view_left_out[v].empty()) continue;  // its pose was not fitted
+    nearest_mm = std::min(nearest_mm, fit.poses[v].camera_from_target_translation_mm.norm());
+    farthest_mm = std::max(farthest_mm, fit.poses[v].camera_from_target_translation_mm.norm());
   }
   result["target_distance_mm"] = {{"nearest", nearest_mm}, {"farthest", farthest_mm}};
   if (shape_free && farthest_mm < kOneDistanceRatio * nearest_mm) {
@@ -402,11 +438,12 @@ void Run(const Options& options, const Context& context) {
       result["views_left_out"][usable.images[v].image] = fit.view_left_out[v];
     }
   for (const std::string& conflict : fit.tolerance_conflicts) warnings.push_back(conflict);
+  for (const std::string& note : fit.tolerance_notes) warnings.push_back(note);
   result["outlier_threshold_px"] = fit.outlier_threshold_px;
   for (size_t v = 0; v < usable.images.size(); ++v) result["per_view_outliers"][usable.images[v].image] = fit.per_view_outliers[v];
   result["sigma_px"] = fit.sigma_px;
   result["tolerances"] = fit_options.tolerances;
-  result["rim_radius_mm"] = {{"guess", fit.guess_rim_radius_mm}, {"fitted", fit.sensor->rim_radius_mm()}};
+  result["rim_radius_mm"] = {{"guess", guess.rim_radius_mm()}, {"fitted", fit.sensor->rim_radius_mm()}};
   if (fit.covariance_ok) {
     result["covariance"]["names"] = fit.covariance_names;
     for (int r = 0; r < fit.covariance.rows(); ++r) {
@@ -420,31 +457,21 @@ void Run(const Options& options, const Context& context) {
   // their reflection points, and infinity.
   std::vector<PredictedError> predicted;
   std::vector<std::string> distance_labels;
-  const double rim_mm = fit.guess_rim_radius_mm;  // n counts design rim radii
+  const double rim_mm = guess.rim_radius_mm();  // n counts the start's (design) rim radii
   constexpr double kMapStepPx = 16.0;
   if (fit.covariance_ok) {
     std::vector<double> distances = options.distances_mm;
-    for (double n : options.distances_n) distances.push_back(n * fit.guess_rim_radius_mm);
+    for (double n : options.distances_n) distances.push_back(n * rim_mm);
     if (distances.empty()) {
-      std::vector<double> corner_distances;
-      for (size_t v = 0; v < usable.images.size(); ++v)
-        for (const CornerObservation& c : usable.images[v].corners) {
-          const auto found = std::find_if(target.corners().begin(), target.corners().end(),
-                                          [&](const TargetCorner& t) { return t.id == c.id; });
-          if (found == target.corners().end() || !fit.view_left_out[v].empty()) continue;
-          const Eigen::Vector3d in_camera =
-              fit.poses[v].camera_from_target_rotation * found->point_in_target + fit.poses[v].camera_from_target_translation_mm;
-          Eigen::Vector3d mirror_point;
-          if (std::visit([&](const auto& m) { return m.ReflectionPoint(in_camera, &mirror_point, &fit.sensor->cache()); },
-                         fit.sensor->model()) == ProjectionStatus::kOk)
-            corner_distances.push_back((in_camera - mirror_point).norm());
-        }
-      double median = NAN, farthest = NAN;
-      MedianAndMax(corner_distances, &median, &farthest);
-      if (std::isfinite(median)) distances.push_back(median);
+      if (const double median_mm = MedianCornerDistanceMm(*fit.sensor, target, usable, fit); std::isfinite(median_mm))
+        distances.push_back(median_mm);
       distances.push_back(kInfinityMm);
     }
-    const std::vector<Eigen::Vector2d> field = FieldPixels(*fit.sensor, FieldOfCorners(*fit.sensor, usable), kMapStepPx);
+    DetectionSet fitted_views = usable;  // the field the fit saw: its fitted views
+    fitted_views.images.clear();
+    for (size_t v = 0; v < usable.images.size(); ++v)
+      if (fit.view_left_out[v].empty()) fitted_views.images.push_back(usable.images[v]);
+    const std::vector<Eigen::Vector2d> field = FieldPixels(*fit.sensor, FieldOfCorners(*fit.sensor, fitted_views), kMapStepPx);
     predicted = PredictProjectionError(*fit.sensor, fit, field, distances);
     for (const PredictedError& map : predicted) {
       const bool infinite = map.distance_mm >= kInfinityMm;
@@ -459,7 +486,10 @@ void Run(const Options& options, const Context& context) {
                                            {"n_rim_radii", infinite ? nlohmann::json("infinity") : nlohmann::json(map.distance_mm / rim_mm)},
                                            {"median_px", map.median_px},
                                            {"max_px", map.max_px},
-                                           {"field_pixels", map.pixels.size()}});
+                                           {"field_pixels", map.pixels.size()},
+                                           {"unpredicted_pixels", map.unpredicted}});
+      if (!std::isfinite(map.max_px))
+        warnings.push_back(std::string("the projection error at ") + label + " could not be predicted (no field pixel projects)");
       if (map.max_px > options.max_predicted_error_px) {
         // What would help: the valleys the data leave open (README "When the predicted
         // error warning fires").

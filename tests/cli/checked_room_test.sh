@@ -42,10 +42,13 @@ for image in detections["images"]:
         continue
     boards += 1
     truth = {c["id"]: c for c in json.load(open(image["image"][:-4] + ".json"))["targets"][0]["corners"]}
-    worst = max(math.dist(c["pixel"], truth[c["id"]]["pixel"]) for c in image["corners"])
-    check(worst < 1.0, "%s: every corner within 1 px of the truth (worst %.2f px): the board, not tiles" %
-          (os.path.basename(image["image"]), worst))
-check(boards >= 5, "%d of 10 boards found" % boards)
+    errors = sorted(math.dist(c["pixel"], truth[c["id"]]["pixel"]) for c in image["corners"])
+    # The board, not tiles (a tile patch lies hundreds of px away) and numbered as printed
+    # (a turned numbering is a board away): the median corner within 1 px of the truth of
+    # its id. OpenCV's corners next to the rim can be pixels off: the worst is printed.
+    check(errors[len(errors) // 2] < 1.0, "%s: the board, numbered as printed (median %.2f px, worst %.2f px from the truth)" %
+          (os.path.basename(image["image"]), errors[len(errors) // 2], errors[-1]))
+check(boards >= 6, "%d of 10 boards found" % boards)
 refused = open(stderr).read().count("a checkerboard-like grid refused")
 print("refused grids: %d" % refused)
 

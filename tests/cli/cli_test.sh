@@ -261,7 +261,8 @@ p = d["predicted_error"]
 assert [round(e["n_rim_radii"], 3) for e in p] == [round(5000 / 43.9, 3), 2.0], p   # --distance-mm first
 assert all(e["max_px"] >= e["median_px"] > 0 for e in p), p
 assert p[1]["max_px"] > p[0]["max_px"], p          # near objects are the uncertain ones
-assert d["tolerances"] == {"m_mm": 2, "decenter_mm": 1, "principal_point_px": 10}, d["tolerances"]
+# Per parameter: the pairs expanded (decenter_mm from the file, principal_point_px from the flag).
+assert d["tolerances"] == {"m_mm": 2, "decenter_x_mm": 1, "decenter_y_mm": 1, "cx_px": 10, "cy_px": 10}, d["tolerances"]
 names = d["covariance"]["names"]; c = d["covariance"]["matrix"]
 assert len(c) == len(names) and all(abs(c[i][i] ** 0.5 - d["parameters"][n]["std"]) < 1e-9 * (1 + c[i][i] ** 0.5) for i, n in enumerate(names))
 assert d["outlier_threshold_px"] >= 0.5 and d["rim_radius_mm"]["fitted"] >= d["rim_radius_mm"]["guess"]
