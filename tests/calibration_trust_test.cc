@@ -333,9 +333,9 @@ DetectionSet RimCheckerboardViews(const CalibrationTarget& board, unsigned seed)
   return WithNoise(ExactViews(board, {100.0, 125.0, 4.5, 8.0, 10.0, 10, seed}), 0.27 / std::sqrt(2.0), seed + 1);
 }
 
-// Measured (3 seeds): without tolerances m lands 155-187 mm (truth 180.4, std 10-14) and
-// objects at n = 7 are misplaced by 7-17 px; with the design tolerances m is within 1.2
-// mm and n = 7 within 1.2-2.6 px. Either way the reported std covers the error (no wrong
+// Measured (3 seeds): without tolerances m lands at 175-190 mm (truth 180.4, std 7-11)
+// and objects at n = 7 are misplaced by 6.4-11.2 px; with the design tolerances m is
+// within 0.9 mm and n = 7 within 0.6-3.0 px. Either way the reported std covers the error (no wrong
 // basin that the statistics hide) and the predicted error warns where the fit is off.
 TEST(WrongBasin, RimCheckerboardsStayHonestAndTolerancesPullThemIn) {
   const CalibrationTarget board =
