@@ -21,26 +21,17 @@ trap 'rm -rf "$work"' EXIT
   --sensor "$data/sensors/ohte-sph-misaligned-guess.yaml" --fix distortion --out "$work/cal" ||
   { echo "FAIL: calibrate exited $?"; exit 1; }
 
-python3 - "$work/render" "$work/cal" <<'PY'
+OMNICAL_CLI_TESTS=$source_dir/tests/cli python3 - "$work/render" "$work/cal" <<'PY'
 import glob, json, math, os, re, sys
+sys.path.insert(0, os.environ["OMNICAL_CLI_TESTS"])
+import sphere_truth
 render, cal = sys.argv[1], sys.argv[2]
 failed = []
 def check(ok, what):
     print(("ok   " if ok else "FAIL ") + what)
     if not ok: failed.append(what)
 
-# The sensor the render used (flow-style YAML written by omnical; numbers by regex).
-text = open(os.path.join(render, "sensor.yaml")).read()
-def scalar(key):
-    return float(re.search(r"\b" + key + r":\s*([-+0-9.eE]+)", text).group(1))
-def pair(key):
-    return [float(x) for x in re.search(r"\b" + key + r":\s*\[([^\]]*)\]", text).group(1).split(",")]
-fx, fy, cx, cy, A, m = (scalar(k) for k in ("fx", "fy", "cx", "cy", "A", "m"))
-tx, ty = (math.radians(v) for v in pair("tilt_deg"))
-dx, dy = pair("decenter_mm")
-centre = (dx + A * math.cos(tx) * math.sin(ty), dy - A * math.sin(tx), m + A * math.cos(tx) * math.cos(ty))
-truth = {"fx_px": fx, "fy_px": fy, "cx_px": cx, "cy_px": cy, "A_mm": A,
-         "decenter_x_mm": centre[0], "decenter_y_mm": centre[1], "m_mm": centre[2] - A}
+truth = sphere_truth.truth_parameters(os.path.join(render, "sensor.yaml"))
 
 result = json.load(open(os.path.join(cal, "calibration.json")))
 p = result["parameters"]

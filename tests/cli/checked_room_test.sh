@@ -27,8 +27,10 @@ trap 'rm -rf "$work"' EXIT
   { echo "FAIL: calibrate exited $?: $(cat "$work/stderr")"; exit 1; }
 cat "$work/stderr"
 
-python3 - "$work/render" "$work/cal" "$work/stderr" <<'PY'
+OMNICAL_CLI_TESTS=$source_dir/tests/cli python3 - "$work/render" "$work/cal" "$work/stderr" <<'PY'
 import json, math, os, re, sys
+sys.path.insert(0, os.environ["OMNICAL_CLI_TESTS"])
+import sphere_truth
 render, cal, stderr = sys.argv[1:4]
 failed = []
 def check(ok, what):
@@ -52,17 +54,7 @@ check(boards >= 6, "%d of 10 boards found" % boards)
 refused = open(stderr).read().count("a checkerboard-like grid refused")
 print("refused grids: %d" % refused)
 
-text = open(os.path.join(render, "sensor.yaml")).read()
-def scalar(key):
-    return float(re.search(r"\b" + key + r":\s*([-+0-9.eE]+)", text).group(1))
-def pair(key):
-    return [float(x) for x in re.search(r"\b" + key + r":\s*\[([^\]]*)\]", text).group(1).split(",")]
-fx, fy, cx, cy, A, m = (scalar(k) for k in ("fx", "fy", "cx", "cy", "A", "m"))
-tx, ty = (math.radians(v) for v in pair("tilt_deg"))
-dx, dy = pair("decenter_mm")
-centre = (dx + A * math.cos(tx) * math.sin(ty), dy - A * math.sin(tx), m + A * math.cos(tx) * math.cos(ty))
-truth = {"fx_px": fx, "fy_px": fy, "cx_px": cx, "cy_px": cy, "A_mm": A, "k1": 0.0, "k2": 0.0,
-         "decenter_x_mm": centre[0], "decenter_y_mm": centre[1], "m_mm": centre[2] - A}
+truth = sphere_truth.truth_parameters(os.path.join(render, "sensor.yaml"))
 result = json.load(open(os.path.join(cal, "calibration.json")))
 p = result["parameters"]
 print("rms %.4f px, %d outliers, predicted error at n = 7: %s" % (result["rms_px"], result["outliers"],

@@ -1,0 +1,27 @@
+"""The truth of a rendered spherical-mirror set as the fit sees it (for the CLI tests).
+
+A sphere's tilt is its gauge (a sphere turned about its centre is the same surface), so
+calibrate holds tilt at the design's 0 and the truth is compared through the sphere's
+centre: decenter + Ry Rx (0, 0, A) laterally, m + A along the axis.
+"""
+import math
+import re
+
+
+def truth_parameters(sensor_yaml_path):
+    """Parameters by calibration.json name from a render's sensor.yaml (flow-style YAML
+    written by omnical; numbers read by regex), in the tilt-0 gauge."""
+    text = open(sensor_yaml_path).read()
+
+    def scalar(key):
+        return float(re.search(r"\b" + key + r":\s*([-+0-9.eE]+)", text).group(1))
+
+    def pair(key):
+        return [float(x) for x in re.search(r"\b" + key + r":\s*\[([^\]]*)\]", text).group(1).split(",")]
+
+    fx, fy, cx, cy, k1, k2, A, m = (scalar(k) for k in ("fx", "fy", "cx", "cy", "k1", "k2", "A", "m"))
+    tx, ty = (math.radians(v) for v in pair("tilt_deg"))
+    dx, dy = pair("decenter_mm")
+    centre = (dx + A * math.cos(tx) * math.sin(ty), dy - A * math.sin(tx), m + A * math.cos(tx) * math.cos(ty))
+    return {"fx_px": fx, "fy_px": fy, "cx_px": cx, "cy_px": cy, "k1": k1, "k2": k2, "A_mm": A,
+            "decenter_x_mm": centre[0], "decenter_y_mm": centre[1], "m_mm": centre[2] - A}
