@@ -19,9 +19,11 @@ mkdir -p "$out"
 "$omnical" render --scene "$omnical_root/datasets-synthetic/scenes/ohte-sph-misaligned-near.yaml" --out "$out/render"
 "$omnical" detect --target "$omnical_root/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml" --images "$out/render" \
   --sensor "$omnical_root/datasets-synthetic/sensors/ohte-sph-misaligned-guess.yaml" --out "$out/detections.json"
+# The design's tolerances as weak priors, and the error predicted where the remap tables
+# below are exact (n = 7): calibration.json and report/predicted_error_*.png.
 "$omnical" calibrate --target "$omnical_root/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml" \
   --detections "$out/detections.json" --sensor "$omnical_root/datasets-synthetic/sensors/ohte-sph-misaligned-guess.yaml" \
-  --out "$out/calibration"
+  --tolerance m_mm=2,decenter_mm=1,tilt_deg=1,principal_point_px=10 --distance-n 7 --out "$out/calibration"
 "$omnical" parallax --sensor "$out/calibration/sensor.yaml" --n 7 --out "$out/calibration/parallax-n7"
 # Remap tables from the calibrated sensor, exact for objects 7 rim radii away, for OpenCV,
 # ffmpeg and NumPy; one rendered image unwarped through them; their error elsewhere.
