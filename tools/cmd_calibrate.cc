@@ -320,13 +320,14 @@ void Run(const Options& options, const Context& context) {
   // Boards of another size than the target (a decoy the detector accepted, e.g. a window
   // of tiles that passed the continuation test) are refused through the fitted sensor and
   // the fit is repeated without them (calib/board_scale.h).
+  std::map<std::string, std::string> wrongly_sized;  // image -> why its board was refused
   if (fit.sensor) {
     std::vector<size_t> refused;
     for (size_t v = 0; v < views.detections.images.size(); ++v) {
       if (!fit.view_left_out[v].empty()) continue;
       const BoardScale check = CheckBoardScale(*fit.sensor, target, views.detections.images[v], fit.poses[v], fit.sigma_px);
       if (!check.refused) continue;
-      warnings.push_back(views.detections.images[v].image + ": view left out: the board " + check.reason);
+      wrongly_sized[views.detections.images[v].image] = "the board " + check.reason;
       refused.push_back(v);
     }
     for (auto v = refused.rbegin(); v != refused.rend(); ++v) {
@@ -431,7 +432,12 @@ void Run(const Options& options, const Context& context) {
                   nearest_mm, farthest_mm, kOneDistanceRatio);
     warnings.push_back(text);
   }
-  // Views the fit left out, and why (their corners are in the report, marked dropped).
+  // Views the fit left out, and why (their corners are in the report, marked dropped;
+  // those of boards of another size are not in the report).
+  for (const auto& [image, why] : wrongly_sized) {
+    warnings.push_back(image + ": view left out of the fit: " + why);
+    result["views_left_out"][image] = why;
+  }
   for (size_t v = 0; v < usable.images.size(); ++v)
     if (!fit.view_left_out[v].empty()) {
       warnings.push_back(usable.images[v].image + ": view left out of the fit: " + fit.view_left_out[v]);
