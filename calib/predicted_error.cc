@@ -154,8 +154,9 @@ std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const F
 
 std::vector<double> ProjectionDisplacement(const Sensor& reference, const Sensor& other,
                                            const std::vector<Eigen::Vector2d>& pixels, double distance_mm) {
-  const Eigen::Matrix2Xd moved = Projected(other, PointsAt(reference, pixels, distance_mm));
-  const Eigen::Matrix2Xd back = Projected(reference, PointsAt(reference, pixels, distance_mm));
+  const Eigen::Matrix3Xd points = PointsAt(reference, pixels, distance_mm);
+  const Eigen::Matrix2Xd moved = Projected(other, points);
+  const Eigen::Matrix2Xd back = Projected(reference, points);
   std::vector<double> displacement(pixels.size());
   for (size_t k = 0; k < pixels.size(); ++k) displacement[k] = (moved.col(k) - back.col(k)).norm();
   return displacement;
