@@ -26,7 +26,7 @@
 #include "model/input_error.h"
 #include "tools/commands.h"
 #include "tools/detect_images.h"
-#include "tools/plot.h"
+#include "calib/report/plot.h"
 
 namespace omnical::cli {
 namespace {

@@ -14,7 +14,7 @@
 #include "model/input_error.h"
 #include "model/optics.h"
 #include "tools/commands.h"
-#include "tools/plot.h"
+#include "calib/report/plot.h"
 
 namespace omnical::cli {
 namespace {

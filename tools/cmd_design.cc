@@ -18,8 +18,8 @@
 #include "model/mirror_design_ode.h"
 #include "tools/cmd_design_fit.h"
 #include "tools/commands.h"
-#include "tools/plot.h"
-#include "tools/profile_drawing.h"
+#include "calib/report/plot.h"
+#include "calib/report/profile_drawing.h"
 
 namespace omnical::cli {
 namespace {

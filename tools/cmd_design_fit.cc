@@ -15,8 +15,8 @@
 #include "model/input_error.h"
 #include "model/mirror_design_fit.h"
 #include "model/ray_quantities.h"
-#include "tools/plot.h"
-#include "tools/profile_drawing.h"
+#include "calib/report/plot.h"
+#include "calib/report/profile_drawing.h"
 
 namespace omnical::cli {
 namespace {

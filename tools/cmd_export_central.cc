@@ -18,7 +18,7 @@
 #include "model/input_error.h"
 #include "model/optics.h"
 #include "tools/commands.h"
-#include "tools/plot.h"
+#include "calib/report/plot.h"
 #include "tools/progress.h"
 #include "tools/view_setup.h"
 

@@ -13,7 +13,7 @@
 #include "model/atomic_write.h"
 #include "model/input_error.h"
 #include "tools/commands.h"
-#include "tools/plot.h"
+#include "calib/report/plot.h"
 #include "tools/progress.h"
 #include "tools/view_setup.h"
 

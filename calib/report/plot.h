@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-namespace omnical::cli {
+namespace omnical {
 
 struct PlotSeries {
   PlotSeries(std::string label_, std::vector<double> x_, std::vector<double> y_, cv::Scalar color_)
@@ -52,4 +52,4 @@ cv::Mat RenderFalseColourMap(const cv::Mat& values, const std::string& title, co
 // PNG written atomically; throws InputError naming the path on failure.
 void WritePng(const std::string& path, const cv::Mat& image);
 
-}  // namespace omnical::cli
+}  // namespace omnical

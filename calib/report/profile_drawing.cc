@@ -1,4 +1,4 @@
-#include "tools/profile_drawing.h"
+#include "calib/report/profile_drawing.h"
 
 #include <opencv2/imgproc.hpp>
 
@@ -9,9 +9,9 @@
 
 #include "model/atomic_write.h"
 #include "model/input_error.h"
-#include "tools/plot.h"
+#include "calib/report/plot.h"
 
-namespace omnical::cli {
+namespace omnical {
 namespace {
 
 constexpr int kWidthPx = 1600, kHeightPx = 1000;
@@ -213,4 +213,4 @@ void WriteProfileDrawing(const ProfileDrawing& drawing, const std::string& svg_p
   WritePng(png_path, RenderPng(layout));
 }
 
-}  // namespace omnical::cli
+}  // namespace omnical

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace omnical::cli {
+namespace omnical {
 
 struct ProfileDrawing {
   std::string title;               // e.g. "omnical design fit: polynomial, equidistant"
@@ -25,4 +25,4 @@ void WriteProfileTable(const ProfileDrawing& drawing, const std::string& source,
 // Throws InputError naming the path when a file cannot be written.
 void WriteProfileDrawing(const ProfileDrawing& drawing, const std::string& svg_path, const std::string& png_path);
 
-}  // namespace omnical::cli
+}  // namespace omnical

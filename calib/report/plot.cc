@@ -1,4 +1,4 @@
-#include "tools/plot.h"
+#include "calib/report/plot.h"
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -10,7 +10,7 @@
 #include "model/atomic_write.h"
 #include "model/input_error.h"
 
-namespace omnical::cli {
+namespace omnical {
 namespace {
 
 const cv::Scalar kBlack(0, 0, 0), kGrid(225, 225, 225), kWhite(255, 255, 255);
@@ -215,4 +215,4 @@ void WritePng(const std::string& path, const cv::Mat& image) {
   WriteFileAtomically(path, [&](std::ostream& out) { out.write(reinterpret_cast<const char*>(bytes.data()), bytes.size()); });
 }
 
-}  // namespace omnical::cli
+}  // namespace omnical
