@@ -764,11 +764,11 @@ std::string FitOptions::Check() const {
   static const std::set<std::string> kBlocks = {"lens", "lens_scale", "distortion", "m", "tilt", "decenter", "shape", "poses"};
   for (const std::string& name : fixed)
     if (!kBlocks.count(name))
-      return "--fix: unknown block '" + name + "' (lens, lens_scale, distortion, m, tilt, decenter, shape, poses)";
-  if (!(robust_loss_px >= 0.0)) return "--loss-px: must be >= 0";
+      return "fixed: unknown block '" + name + "' (lens, lens_scale, distortion, m, tilt, decenter, shape, poses)";
+  if (!(robust_loss_px >= 0.0)) return "robust_loss_px: must be >= 0";
   if (!(outlier_floor_px >= 0.0) || !(outlier_sigmas > 0.0) || !(view_rms_ratio > 1.0))
     return "outlier rule: outlier_floor_px >= 0, outlier_sigmas > 0 and view_rms_ratio > 1";
-  if (max_iterations < 1) return "--max-iterations: must be >= 1";
+  if (max_iterations < 1) return "max_iterations: must be >= 1";
   return {};
 }
 

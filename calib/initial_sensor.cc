@@ -78,7 +78,7 @@ SensorModel WithMirror(const Model& model, const P<double>& mirror) {
 
 Sensor Validated(SensorModel model, const std::string& what) {
   const std::string problem = ValidateSensorModel(model);
-  if (!problem.empty()) throw InputError(InputMessage(what, "--profile", "the starting sensor is not valid: " + problem));
+  if (!problem.empty()) throw InputError(InputMessage(what, "profile", "the starting sensor is not valid: " + problem));
   return Sensor(std::move(model));
 }
 
@@ -89,7 +89,7 @@ Sensor SensorFromRimCircle(const RimCircle& rim, int image_width_px, int image_h
   if (!(rim.radius_px > 0.0) || !rim.centre_px.allFinite())
     throw InputError(InputMessage("rim circle", "", "no mirror rim found in the images"));
   if (!(rim_field_deg > 10.0 && rim_field_deg < 170.0))
-    throw InputError(InputMessage("--rim-field-deg", "", "must lie in (10, 170) deg"));
+    throw InputError(InputMessage("rim_field_deg", "", "must lie in (10, 170) deg"));
   const double rim_mm = kNominalRimRadiusMm;
   const double slope = std::tan(0.5 * rim_field_deg * M_PI / 180.0);  // dz/dr at the rim
   Catadioptric<double, ParaboloidProfile, OrthographicLens> base;
@@ -112,15 +112,15 @@ Sensor SensorFromRimCircle(const RimCircle& rim, int image_width_px, int image_h
     return Validated(WithMirror<SphereProfile>(base, SphereProfile<double>{rim_mm * std::sqrt(1.0 + 1.0 / (slope * slope))}),
                      "rim circle");
   }
-  throw InputError(InputMessage("--profile", "", "'" + profile +
+  throw InputError(InputMessage("profile", "", "'" + profile +
                                                      "' cannot start from the rim circle alone (sphere, paraboloid or "
-                                                     "polynomial; a hyperboloid needs --sensor with its design)"));
+                                                     "polynomial; a hyperboloid needs a guess with its design)"));
 }
 
 Sensor ConvertProfile(const Sensor& guess, const std::string& profile) {
   if (profile == guess.profile_name()) return guess;
   if (profile != "sphere" && profile != "paraboloid" && profile != "polynomial" && profile != "hyperboloid")
-    throw InputError(InputMessage("--profile", "", "unknown profile '" + profile + "' (sphere, paraboloid, polynomial, hyperboloid)"));
+    throw InputError(InputMessage("profile", "", "unknown profile '" + profile + "' (sphere, paraboloid, polynomial, hyperboloid)"));
   return std::visit(
       [&](const auto& model) -> Sensor {
         // Samples of the guess's sag and slope from the axis to the rim.
@@ -135,20 +135,20 @@ Sensor ConvertProfile(const Sensor& guess, const std::string& profile) {
         // Start every family at the guess's vertex curvature: g'(0) = 1 / (2 R_vertex).
         const double vertex_slope = model.mirror.template EvaluateSag<double>(0.0).dz_ds;
         if (!(vertex_slope > 0.0))
-          throw InputError(InputMessage("--profile", "", "the guess's mirror is flat or concave at its vertex"));
+          throw InputError(InputMessage("profile", "", "the guess's mirror is flat or concave at its vertex"));
         const double vertex_radius = 1.0 / (2.0 * vertex_slope);
         if (profile == "paraboloid") {
           const auto p = FitProfile<ParaboloidProfile, 1>(samples, r2s, rim, {vertex_radius / 2.0}, 1);
-          return Validated(WithMirror<ParaboloidProfile>(model, ParaboloidProfile<double>{p[0]}), "--sensor");
+          return Validated(WithMirror<ParaboloidProfile>(model, ParaboloidProfile<double>{p[0]}), "guess");
         }
         if (profile == "sphere") {
           const auto p = FitProfile<SphereProfile, 1>(samples, r2s, rim, {std::max(vertex_radius, 1.05 * rim)}, 1);
-          return Validated(WithMirror<SphereProfile>(model, SphereProfile<double>{p[0]}), "--sensor");
+          return Validated(WithMirror<SphereProfile>(model, SphereProfile<double>{p[0]}), "guess");
         }
         if (profile == "hyperboloid") {
           // z = (B / A) (sqrt(A^2 + r^2) - A): vertex radius A^2 / B; start with B = A.
           const auto p = FitProfile<HyperboloidProfile, 2>(samples, r2s, rim, {vertex_radius, vertex_radius}, 2);
-          return Validated(WithMirror<HyperboloidProfile>(model, HyperboloidProfile<double>{p[0], p[1]}), "--sensor");
+          return Validated(WithMirror<HyperboloidProfile>(model, HyperboloidProfile<double>{p[0], p[1]}), "guess");
         }
         std::vector<double> start(kDefaultPolynomialCoefficients, 0.0);
         start[0] = vertex_slope;
@@ -156,7 +156,7 @@ Sensor ConvertProfile(const Sensor& guess, const std::string& profile) {
                                                                                          kDefaultPolynomialCoefficients);
         return Validated(WithMirror<EvenPolynomialProfile>(
                              model, EvenPolynomialProfile<double>::FromParams(p.data(), kDefaultPolynomialCoefficients)),
-                         "--sensor");
+                         "guess");
       },
       guess.model());
 }

@@ -25,7 +25,7 @@ constexpr double kDefaultRimFieldDeg = 105.0;
 constexpr int kDefaultPolynomialCoefficients = 3;
 
 // profile: sphere, paraboloid or polynomial (hyperboloid needs a pinhole at its focus,
-// hence a guess). Throws InputError naming `--profile` otherwise.
+// hence a guess). Throws InputError naming the field `profile` otherwise.
 Sensor SensorFromRimCircle(const RimCircle& rim, int image_width_px, int image_height_px, const std::string& profile,
                            double rim_field_deg = kDefaultRimFieldDeg);
 

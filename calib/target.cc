@@ -230,7 +230,7 @@ void CalibrationTarget::WritePng(const std::string& path, double dpi) const {
   const int width = static_cast<int>(std::lround(size.x() / mm_per_px));
   const int height = static_cast<int>(std::lround(size.y() / mm_per_px));
   if (width < 1 || height < 1 || static_cast<double>(width) * height > 4e8)
-    throw InputError(InputMessage(path, "--dpi", "gives an image of " + std::to_string(width) + " x " +
+    throw InputError(InputMessage(path, "dpi", "gives an image of " + std::to_string(width) + " x " +
                                                      std::to_string(height) + " px"));
   cv::Mat image(height, width, CV_8UC1);
   constexpr int kSub = 4;  // 4 x 4 samples per pixel: cell edges that fall inside a pixel are grey

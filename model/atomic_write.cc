@@ -49,14 +49,16 @@ class InFlight {
   int slot_ = -1;
 };
 
-extern "C" void RemoveInFlightAndDie(int signal_number) {
+extern "C" void RemoveInFlightAndDie(int signal_number) { RemoveTemporaryFilesAndDie(signal_number); }
+
+}  // namespace
+
+void RemoveTemporaryFilesAndDie(int signal_number) {
   for (int i = 0; i < kSlots; ++i)
     if (slot_used[i]) ::unlink(temp_paths[i]);
   std::signal(signal_number, SIG_DFL);
   std::raise(signal_number);
 }
-
-}  // namespace
 
 void RemoveTemporaryFilesOnInterrupt() {
   for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {

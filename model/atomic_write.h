@@ -27,5 +27,7 @@ void CreateOutputDirectory(const std::string& dir);
 // written at that moment, then let the signal end the process as it would have: Ctrl-C
 // leaves the previous outputs and no stray temporary file (the CLI calls it first).
 void RemoveTemporaryFilesOnInterrupt();
+// What those handlers do, for a front end's own handler: async-signal-safe.
+void RemoveTemporaryFilesAndDie(int signal_number);
 
 }  // namespace omnical

@@ -10,7 +10,7 @@ out=$2
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 data=$root/datasets-synthetic
 mkdir -p "$out"
-run() { "$omnical" --quiet "$@" >/dev/null 2>>"$out/stderr.txt"; }
+run() { "$omnical" --quiet "$@" >/dev/null 2>>"$out/stderr.txt" || echo "FAILED ($?): $*" >>"$out/stderr.txt"; }
 for set in ohte-sph-near ohte-sph-misaligned-near ohte-edi-near ohte-svp-near; do
   sensor=$(sed -n 's/^sensor: \.\.\/sensors\/\(.*\)$/\1/p' "$data/scenes/$set.yaml")
   guess=$data/sensors/$sensor
@@ -34,10 +34,10 @@ for sensor in ohte-sph ohte-edi ohte-svp ohte-sph-misaligned; do
   run parallax --maps "$out/remap-$sensor-pano" --out "$out/parallax-maps-$sensor"
   run characterize --sensor "$s" --out "$out/characterize-$sensor"
   run export-central --sensor "$s" --model mei --n 7 --out "$out/central-$sensor"
-  run unwarp --maps "$out/remap-$sensor-pano" --input "$data/rendered/ohte-sph-near/near-front.png" --out "$out/unwarp-$sensor.png"
+  run unwarp --maps "$out/remap-$sensor-pano" --input "$(ls "$data"/rendered/$sensor-near/*.png | head -1)" --out "$out/unwarp-$sensor.png"
 done
 for design in gaechter-uniform gaechter-logpolar; do
-  run design ode --spec "$data/designs/$design.yaml" --out "$out/design-$design" || echo "design $design failed" >>"$out/stderr.txt"
+  run design ode --spec "$data/designs/$design.yaml" --out "$out/design-$design"
 done
 
 run design fit --profile sphere --rim-omega 135 --rim-theta 12 --out "$out/design-fit-sph"

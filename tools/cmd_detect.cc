@@ -1,13 +1,14 @@
 // omnical detect: the target's corners in omni images (AprilTag 3 or OpenCV's
 // checkerboard detector on the mirrored image; with --sensor, tags re-detected in virtual
 // perspective views through the guess), refined to sub-pixel (calib/refine_corners.h),
-// parallel over images; unreadable images are reported and skipped.
+// parallel over images (calib/image_detection.h); unreadable images are reported and skipped.
 #include <algorithm>
-#include <optional>
 #include <thread>
 
+#include "calib/image_detection.h"
+#include "calib/image_file.h"
 #include "tools/commands.h"
-#include "tools/detect_images.h"
+#include "tools/progress.h"
 
 namespace omnical::cli {
 
@@ -17,8 +18,9 @@ Command DetectCommand() {
             auto spec = std::make_shared<std::string>();
             auto images = std::make_shared<std::string>();
             auto out = std::make_shared<std::string>();
-            auto threads = std::make_shared<int>(static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
             auto sensor_path = std::make_shared<std::string>();
+            auto options = std::make_shared<DetectionOptions>();
+            options->threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
             sub.add_option("--target", *spec, "Target spec (YAML, Kalibr keys)")->required();
             sub.add_option("--sensor", *sensor_path,
                            "Sensor guess (YAML): re-detect aprilgrid tags in virtual perspective views through it, refine corners in patches through it");
@@ -26,28 +28,25 @@ Command DetectCommand() {
             sub.add_option("--out", *out, "Detections file (JSON)")->required();
             auto no_refine = std::make_shared<bool>(false);
             sub.add_flag("--no-refine", *no_refine, "Keep AprilTag's corners (no edge-profile refinement)");
-            auto refine_checkerboards = std::make_shared<bool>(false);
-            sub.add_flag("--refine-checkerboard", *refine_checkerboards,
+            sub.add_flag("--refine-checkerboard", options->refine_checkerboards,
                          "Also refine checkerboard corners with cornerSubPix (sharper on clean images; on the real "
                          "Mei images OpenCV's own corners fit better)");
-            sub.add_option("--threads", *threads, "Worker threads")->check(CLI::Range(1, 256))->capture_default_str();
+            sub.add_option("--threads", options->threads, "Worker threads")->check(CLI::Range(1, 256))->capture_default_str();
             return [=, &context]() {
-              const bool refine = !*no_refine;
               const CalibrationTarget target = CalibrationTarget::FromYaml(*spec);
-              std::optional<Sensor> guess;
-              if (!sensor_path->empty()) guess = LoadSensorYaml(*sensor_path);
-              ImageDetectionOptions detection;
-              detection.guess = guess ? &*guess : nullptr;
-              detection.refine = refine;
-              detection.refine_checkerboards = *refine_checkerboards;
-              detection.threads = *threads;
-              detection.quiet = context.quiet;
-              const DetectionSet set = DetectImages(target, *spec, *images, detection).detections;
+              if (!sensor_path->empty()) options->guess = LoadSensorYaml(*sensor_path);
+              options->refine = !*no_refine;
+              options->progress = TerminalProgress(context);
+              DetectedImages found = NamingFlags({{"guess", "--sensor"}, {"threads", "--threads"}}, [&] {
+                return DetectImageFiles(target, ListImages(*images), *images, *options);
+              });
+              found.detections.target_spec = *spec;
+              PrintWarnings(found.warnings, context);
               int corners = 0;
-              for (const ImageDetections& image : set.images) corners += static_cast<int>(image.corners.size());
-              WriteDetections(set, *out);
+              for (const ImageDetections& image : found.detections.images) corners += static_cast<int>(image.corners.size());
+              WriteDetections(found.detections, *out);
               if (!context.quiet)
-                std::printf("%zu images, %d corners -> %s\n", set.images.size(), corners, out->c_str());
+                std::printf("%zu images, %d corners -> %s\n", found.detections.images.size(), corners, out->c_str());
             };
           }};
 }

@@ -4,6 +4,7 @@
 #include <opencv2/core/utils/logger.hpp>
 
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <iostream>
 #include <map>
@@ -13,6 +14,7 @@
 #include "model/atomic_write.h"
 #include "model/input_error.h"
 #include "tools/commands.h"
+#include "tools/progress.h"
 
 namespace {
 
@@ -37,6 +39,8 @@ int main(int argc, char** argv) {
   // Ctrl-C: the outputs are renamed into place only when complete; this removes the one
   // being written, so an interrupted run leaves the previous results and nothing else.
   RemoveTemporaryFilesOnInterrupt();
+  // SIGINT first asks the running job to stop through its progress callback.
+  cli::InstallInterruptHandler();
   CLI::App app{"omnical: calibration and correction of non-central catadioptric cameras"};
   app.require_subcommand(1);
   cli::Context context;
@@ -78,6 +82,11 @@ int main(int argc, char** argv) {
   } catch (const InputError& error) {
     std::cerr << "omnical: error: " << error.what() << "\n";
     return 2;
+  } catch (const Cancelled&) {
+    // Stopped by Ctrl-C: end the way the signal would have (exit status 128 + SIGINT).
+    std::signal(SIGINT, SIG_DFL);
+    std::raise(SIGINT);
+    return 130;
   } catch (const std::exception& error) {
     std::cerr << "omnical: internal error: " << error.what() << "\n";
     return 1;

@@ -2,9 +2,44 @@
 
 #include <unistd.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "model/atomic_write.h"
 
 namespace omnical::cli {
+namespace {
+
+volatile std::sig_atomic_t interrupted = 0;
+
+// First Ctrl-C: ask the job to stop at its next progress report (it unwinds, removing
+// the temporary files it was writing). A second one, or a job that does not report:
+// end now the way the signal would (model/atomic_write.h removes temporaries).
+extern "C" void OnInterrupt(int signal_number) {
+  if (interrupted) {
+    RemoveTemporaryFilesAndDie(signal_number);
+    return;
+  }
+  interrupted = 1;
+}
+
+struct Bar {
+  std::mutex mutex;
+  std::string stage;
+  long done = -1, total = 0;
+  std::chrono::steady_clock::time_point last;
+  void Draw() {
+    const int percent = total > 0 ? static_cast<int>(100 * done / total) : 100;
+    std::fprintf(stderr, "\r%s: %3d%% (%ld/%ld)", stage.c_str(), percent, done, total);
+    std::fflush(stderr);
+  }
+};
+
+}  // namespace
 
 Progress::Progress(std::string label, long total, bool quiet)
     : label_(std::move(label)), total_(total), enabled_(!quiet && ::isatty(STDERR_FILENO)) {}
@@ -29,6 +64,40 @@ void Progress::Draw(long done) {
   const int percent = total_ > 0 ? static_cast<int>(100 * done / total_) : 100;
   std::fprintf(stderr, "\r%s: %3d%% (%ld/%ld)", label_.c_str(), percent, done, total_);
   std::fflush(stderr);
+}
+
+bool InterruptRequested() { return interrupted != 0; }
+
+void InstallInterruptHandler() {
+  struct sigaction action = {};
+  action.sa_handler = OnInterrupt;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+}
+
+ProgressCallback TerminalProgress(const Context& context) {
+  const bool enabled = !context.quiet && ::isatty(STDERR_FILENO);
+  auto bar = std::make_shared<Bar>();
+  return [enabled, bar](const ProgressUpdate& update) {
+    if (!enabled) return !InterruptRequested();
+    std::lock_guard<std::mutex> lock(bar->mutex);
+    const auto now = std::chrono::steady_clock::now();
+    if (update.stage != bar->stage) {
+      if (!bar->stage.empty()) std::fputc('\n', stderr);
+      bar->stage = update.stage;
+      bar->last = {};
+    }
+    bar->done = update.done, bar->total = update.total;
+    if (update.done >= update.total || now - bar->last >= std::chrono::milliseconds(100)) {
+      bar->last = now;
+      bar->Draw();
+      if (update.done >= update.total) {
+        std::fputc('\n', stderr);
+        bar->stage.clear();
+      }
+    }
+    return !InterruptRequested();
+  };
 }
 
 }  // namespace omnical::cli

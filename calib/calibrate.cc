@@ -1,0 +1,435 @@
+#include "calib/calibrate.h"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+
+#include "calib/board_scale.h"
+#include "calib/image_file.h"
+#include "calib/rim_circle.h"
+#include "model/input_error.h"
+
+namespace omnical {
+namespace {
+
+// Targets whose distances from the lens span less than this ratio count as "one
+// distance" (the warning above the fit's results).
+constexpr double kOneDistanceRatio = 1.5;
+
+// The detections without corners the target does not have and without corners marked
+// unrefined (the detector's own position, ~5x worse than refined ones: unweighted among
+// them they biased the mirror's size on renders); *unrefined counts the latter. Throws if
+// no corner id matches.
+DetectionSet FittableCorners(const CalibrationInput& input, DetectionSet detections, int* unrefined) {
+  std::set<int> ids;
+  for (const TargetCorner& c : input.target.corners()) ids.insert(c.id);
+  int matched = 0;
+  *unrefined = 0;
+  for (ImageDetections& image : detections.images) {
+    image.corners.erase(std::remove_if(image.corners.begin(), image.corners.end(),
+                                       [&](const CornerObservation& c) {
+                                         if (!ids.count(c.id)) return true;
+                                         ++matched;
+                                         *unrefined += c.unrefined;
+                                         return c.unrefined;
+                                       }),
+                        image.corners.end());
+  }
+  if (matched == 0)
+    throw InputError(InputMessage(input.target_name, "", "the target spec matches no corner id in " + input.source));
+  return detections;
+}
+
+struct UsableViews {
+  DetectionSet detections;  // the views with a starting pose
+  std::vector<TargetPose> poses;
+  int observations = 0;  // corners
+};
+
+// Views with at least 4 corners and a pose through `start`; throws when they cannot
+// determine the sensor.
+UsableViews ViewsForFit(const Sensor& start, const CalibrationInput& input, const DetectionSet& detections,
+                        std::vector<CalibrationWarning>* warnings) {
+  UsableViews views;
+  views.detections = detections;
+  views.detections.images.clear();
+  for (const ImageDetections& image : detections.images) {
+    TargetPose pose;
+    if (image.corners.size() < 4 || !InitialTargetPose(start, input.target, image, &pose)) {
+      warnings->push_back({WarningCode::kViewSkipped, image.image, image.image + ": too few usable corners, view skipped"});
+      continue;
+    }
+    views.detections.images.push_back(image);
+    views.poses.push_back(pose);
+  }
+  // Enough data for what is asked: 2 residuals per corner against 6 per view plus the
+  // sensor's free parameters, and views that differ (one pose says nothing about the
+  // mirror).
+  for (const ImageDetections& image : views.detections.images) views.observations += static_cast<int>(image.corners.size());
+  const int sensor_parameters = static_cast<int>(SensorParameters(start).size());
+  const int view_count = static_cast<int>(views.detections.images.size());
+  if (view_count < 3 || 2 * views.observations < 2 * (6 * view_count + sensor_parameters))
+    throw InputError(InputMessage(input.source, "images",
+                                  std::to_string(view_count) + " usable views with " + std::to_string(views.observations) +
+                                      " corners are too few for the " + std::to_string(sensor_parameters) +
+                                      " sensor parameters (need >= 3 views)"));
+  double spread_deg = 0.0, spread_mm = 0.0;
+  for (const TargetPose& pose : views.poses) {
+    spread_deg = std::max(spread_deg, pose.camera_from_target_rotation.angularDistance(views.poses[0].camera_from_target_rotation) * 180.0 / M_PI);
+    spread_mm = std::max(spread_mm, (pose.camera_from_target_translation_mm - views.poses[0].camera_from_target_translation_mm).norm());
+  }
+  if (spread_deg < 1.0 && spread_mm < 5.0)
+    throw InputError(InputMessage(input.source, "images", "all views show the target at one pose: move it between images"));
+  return views;
+}
+
+// The rim circle of the images a detections file names (the median over those that read).
+std::optional<RimCircle> RimOfImages(const DetectionSet& detections) {
+  std::vector<RimCircle> circles;
+  for (const ImageDetections& image : detections.images) {
+    const cv::Mat grey = ReadImageFile(image.image, cv::IMREAD_GRAYSCALE);
+    if (grey.empty()) continue;
+    if (auto circle = DetectRimCircle(grey)) circles.push_back(*circle);
+  }
+  return MedianRimCircle(circles);
+}
+
+// The corners, detected here (with the rim circles when there is no guess) or given.
+DetectedImages FindCorners(const CalibrationInput& input, const CalibrationOptions& options,
+                           const std::optional<Sensor>& through, bool rim_circles) {
+  DetectionOptions detection;
+  detection.guess = through;
+  detection.rim_circles = rim_circles;
+  detection.threads = options.threads;
+  detection.progress = options.progress;
+  DetectedImages found = input.image_paths.empty() ? DetectImages(input.target, input.images, detection)
+                                                   : DetectImageFiles(input.target, input.image_paths, input.source, detection);
+  found.detections.target_spec = input.target_name;
+  return found;
+}
+
+bool ShapeParameter(const std::string& name) {
+  return name == "A_mm" || name == "B_mm" || (name.size() >= 2 && name[0] == 'c' && std::isdigit(static_cast<unsigned char>(name[1])));
+}
+bool ScaleLike(const std::string& name) {
+  return name == "fx_px" || name == "fy_px" || name == "scale_px_per_mm" || name == "m_mm" || ShapeParameter(name);
+}
+
+// The fit's tolerances: the guess's (those that apply to the fitted family), then the
+// options' (which win), centred on the start's values.
+FitOptions FitOptionsFor(const CalibrationInput& input, const CalibrationOptions& options, const Sensor& start,
+                         std::vector<CalibrationWarning>* warnings) {
+  FitOptions fit = FitOptions::DefaultsFor(start);
+  fit.fixed.insert(options.fixed.begin(), options.fixed.end());
+  fit.robust_loss_px = options.loss_px;
+  fit.max_iterations = options.max_iterations;
+  if (const std::string why = fit.Check(); !why.empty()) throw InputError(why);
+  fit.tolerances = ExpandTolerances(input.guess_tolerances);
+  for (auto it = fit.tolerances.begin(); it != fit.tolerances.end();) {
+    FitOptions one;
+    one.tolerances = {*it};
+    if (one.CheckFor(start).empty()) {
+      ++it;
+      continue;
+    }
+    // Converted to another family: the old family's shape tolerances do not apply.
+    warnings->push_back({WarningCode::kToleranceNotApplicable, it->first,
+                         input.guess_name + ": the tolerance on " + it->first + " does not apply to a " +
+                             start.profile_name() + " mirror and is not used"});
+    it = fit.tolerances.erase(it);
+  }
+  for (const auto& [name, value] : ExpandTolerances(options.tolerances)) fit.tolerances[name] = value;
+  if (const std::string why = fit.CheckFor(start); !why.empty()) throw InputError("tolerances: " + why);
+  for (const ParameterEstimate& p : SensorParameters(start)) fit.design[p.name] = p.value;
+  return fit;
+}
+
+// Stability: the fit repeated without each view in turn; the spread of each parameter.
+std::map<std::string, CalibrationRecord::Spread> LeaveOneOut(const Sensor& start, const CalibrationInput& input,
+                                                              const UsableViews& views, FitOptions quick,
+                                                              const ProgressCallback& callback) {
+  std::map<std::string, std::vector<double>> folds;
+  quick.compute_covariance = false;
+  ProgressReporter progress(callback, "leave-one-out", static_cast<long>(views.detections.images.size()));
+  for (size_t left_out = 0; left_out < views.detections.images.size(); ++left_out) {
+    DetectionSet subset = views.detections;
+    std::vector<TargetPose> subset_poses = views.poses;
+    subset.images.erase(subset.images.begin() + left_out);
+    subset_poses.erase(subset_poses.begin() + left_out);
+    const FitResult fold = FitSensor(start, input.target, subset, subset_poses, quick);
+    for (const ParameterEstimate& p : fold.parameters) folds[p.name].push_back(p.value);
+    progress.Step();
+  }
+  std::map<std::string, CalibrationRecord::Spread> spread;
+  for (const auto& [name, values] : folds) {
+    const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+    double mean = 0.0, square = 0.0;
+    for (double v : values) mean += v;
+    mean /= values.size();
+    for (double v : values) square += (v - mean) * (v - mean);
+    spread[name] = {*lo, *hi, std::sqrt(square / values.size())};
+  }
+  return spread;
+}
+
+}  // namespace
+
+std::string CalibrationOptions::Check() const {
+  static const std::set<std::string> kProfiles = {"", "sphere", "paraboloid", "polynomial", "hyperboloid"};
+  if (!kProfiles.count(profile)) return "profile: unknown mirror family '" + profile + "' (sphere, paraboloid, polynomial, hyperboloid)";
+  if (!(rim_field_deg >= 10.0 && rim_field_deg <= 170.0)) return "rim_field_deg: must be in [10, 170]";
+  if (!(loss_px >= 0.0 && std::isfinite(loss_px))) return "loss_px: must be >= 0 and finite";
+  if (max_iterations < 1) return "max_iterations: must be >= 1";
+  if (detection_passes < 1) return "detection_passes: must be >= 1";
+  if (threads < 1) return "threads: must be >= 1";
+  for (double d : distances_mm)
+    if (!(d > 0.0 && std::isfinite(d))) return "distances_mm: must be > 0 and finite";
+  for (double n : distances_n)
+    if (!(n > 0.0 && std::isfinite(n))) return "distances_n: must be > 0 and finite";
+  if (!(max_predicted_error_px >= 0.0 && std::isfinite(max_predicted_error_px))) return "max_predicted_error_px: must be >= 0";
+  if (!(predicted_error_step_px > 0.0 && std::isfinite(predicted_error_step_px))) return "predicted_error_step_px: must be > 0";
+  return "";
+}
+
+CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOptions& options) {
+  if (const std::string why = options.Check(); !why.empty()) throw InputError(why);
+  const int sources = !input.image_paths.empty() + !input.images.empty() + input.detections.has_value();
+  if (sources != 1) throw InputError("images: give either images (detected here) or detections");
+  const bool from_images = !input.detections;
+  std::vector<CalibrationWarning> warnings;
+  CalibrationRecord record;
+  std::vector<PredictedError> predicted;
+  std::vector<std::string> distance_labels;
+  DetectionSet detections;
+  std::optional<RimCircle> rim;
+  if (from_images) {
+    DetectedImages found = FindCorners(input, options, input.guess, !input.guess);
+    detections = std::move(found.detections);
+    warnings = std::move(found.warnings);
+    if (!input.guess) rim = MedianRimCircle(found.rim_circles);
+  } else {
+    detections = *input.detections;
+    if (!input.guess) rim = RimOfImages(detections);
+  }
+  // The starting sensor: the guess (in another profile family if asked), or, with no
+  // guess, the rim circle of the images.
+  std::optional<Sensor> start_sensor;
+  if (input.guess) {
+    start_sensor = options.profile.empty() ? *input.guess : ConvertProfile(*input.guess, options.profile);
+    record.start = input.guess_name + (options.profile.empty() ? "" : " as a " + options.profile + " mirror");
+  } else {
+    if (!rim)
+      throw InputError(InputMessage(input.source, "images", "no mirror rim circle found to start from; give a sensor guess"));
+    const std::string profile = options.profile.empty() ? "polynomial" : options.profile;
+    start_sensor = SensorFromRimCircle(*rim, detections.image_width_px, detections.image_height_px, profile, options.rim_field_deg);
+    record.start = "rim circle, " + profile + " mirror, orthographic lens";
+    record.rim_circle = CalibrationRecord::RimCircleRecord{rim->centre_px, rim->radius_px, rim->inlier_fraction, rim->rms_px};
+  }
+  const Sensor& guess = *start_sensor;
+  if (detections.image_width_px != guess.image_width_px() || detections.image_height_px != guess.image_height_px())
+    throw InputError(InputMessage(input.source, "image_size",
+                                  std::to_string(detections.image_width_px) + " x " + std::to_string(detections.image_height_px) +
+                                      " differs from the sensor's " + std::to_string(guess.image_width_px()) + " x " +
+                                      std::to_string(guess.image_height_px())));
+  const FitOptions fit_options = FitOptionsFor(input, options, guess, &warnings);
+
+  int unrefined = 0;
+  UsableViews views = ViewsForFit(guess, input, FittableCorners(input, detections, &unrefined), &warnings);
+  std::optional<Sensor> refit_start;  // the previous pass's fit, where the last fit started
+  ProgressReporter passes(options.progress, "fit", 1);
+  FitResult fit = FitSensor(guess, input.target, views.detections, views.poses, fit_options);
+  passes.Step();
+  // Second detection pass (aprilgrid from images): the corners are refined in patches
+  // through a sensor, and a tag's straight edges are straight there only as far as that
+  // sensor is right. Through the design guess the patch edges bend, and the corners
+  // carried a radius-dependent bias the mirror's size absorbed; re-detected through the
+  // first fit they do not (30-view render: A 6 std off after one pass, 0.5 std after two;
+  // tests/cli/calibrate_render_test.sh).
+  const bool redetect = from_images && input.target.type() == CalibrationTarget::Type::kAprilGrid;
+  for (int pass = 2; redetect && pass <= options.detection_passes && fit.sensor; ++pass) {
+    refit_start = *fit.sensor;
+    DetectedImages found = FindCorners(input, options, refit_start, false);
+    detections = std::move(found.detections);
+    views = ViewsForFit(*refit_start, input, FittableCorners(input, detections, &unrefined), &warnings);
+    fit = FitSensor(*refit_start, input.target, views.detections, views.poses, fit_options);
+    ProgressReporter(options.progress, "fit", 1).Step();
+  }
+  const Sensor& fit_start = refit_start ? *refit_start : guess;
+  // Boards of another size than the target (a decoy the detector accepted, e.g. a window
+  // of tiles that passed the continuation test) are refused through the fitted sensor and
+  // the fit is repeated without them (calib/board_scale.h).
+  if (fit.sensor) {
+    std::vector<size_t> refused;
+    for (size_t v = 0; v < views.detections.images.size(); ++v) {
+      if (!fit.view_left_out[v].empty()) continue;
+      const BoardScale check = CheckBoardScale(*fit.sensor, input.target, views.detections.images[v], fit.poses[v], fit.sigma_px);
+      if (!check.refused) continue;
+      record.views_left_out[views.detections.images[v].image] = "the board " + check.reason;
+      refused.push_back(v);
+    }
+    for (auto v = refused.rbegin(); v != refused.rend(); ++v) {
+      views.observations -= static_cast<int>(views.detections.images[*v].corners.size());
+      views.detections.images.erase(views.detections.images.begin() + *v);
+      views.poses.erase(views.poses.begin() + *v);
+    }
+    if (!refused.empty()) {
+      if (views.detections.images.size() < 3)
+        throw InputError(InputMessage(input.source, "images",
+                                      std::to_string(views.detections.images.size()) +
+                                          " views are left once the boards of another size are refused (need >= 3)"));
+      fit = FitSensor(fit_start, input.target, views.detections, views.poses, fit_options);
+    }
+  }
+  const DetectionSet& usable = views.detections;
+  if (!fit.sensor) throw InputError(InputMessage(input.source, "", "the fit failed: " + fit.solver_report));
+  const std::string why_invalid = ValidateSensorModel(fit.sensor->model());
+
+  record.rms_px = fit.rms_px;
+  record.converged = fit.converged;
+  record.outliers = fit.outliers;
+  record.dropped = fit.dropped;
+  record.unrefined_corners_left_out = unrefined;
+  record.observations = fit.observations;
+  record.solver_report = fit.solver_report;
+  record.fixed_blocks = fit_options.fixed;
+  record.robust_loss_px = fit_options.robust_loss_px;
+  record.covariance_ok = fit.covariance_ok;
+  record.detection_passes = refit_start ? options.detection_passes : 1;
+  if (options.leave_one_out) record.leave_one_out = LeaveOneOut(fit_start, input, views, fit_options, options.progress);
+  if (!why_invalid.empty())
+    warnings.push_back({WarningCode::kSensorInvalid, "", "the fitted sensor fails validation: " + why_invalid});
+  if (!fit.converged) warnings.push_back({WarningCode::kNotConverged, "", "the solver did not converge: " + fit.solver_report});
+  if (!fit.covariance_ok)
+    warnings.push_back({WarningCode::kFreeGauge, "",
+                        "the parameters are not all determined by the data (a free gauge): fix one with --fix"});
+  // Weakly determined: the "dolly zoom" between fx and m is the usual one (the lens sees
+  // the mirror under a small angle); fixing m from the design or fx from the lens helps.
+  // Only scale-like parameters have a meaningful relative std (tilts, decenters, the
+  // principal point and distortion are naturally near zero).
+  for (const ParameterEstimate& p : fit.parameters)
+    if (!p.fixed && ScaleLike(p.name) && std::isfinite(p.std) && p.value != 0.0 && p.std > 0.05 * std::abs(p.value))
+      warnings.push_back({WarningCode::kWeaklyDetermined, p.name,
+                          p.name + " is weakly determined (std " + std::to_string(100.0 * p.std / std::abs(p.value)) +
+                              (p.name == "fx_px" || p.name == "fy_px" || p.name == "m_mm"
+                                   ? "% of its value): fx and m trade off; fix m from the design (--fix m) or the lens "
+                                     "scale, or add views at more distances"
+                                   : "% of its value): views covering more of the mirror, at more distances, help")});
+  // One distance: a non-central mirror's shape shows in how its image changes with the
+  // object's distance (the viewpoints slide), so with every board at about the same range
+  // the shape trades off against m and the lens scale.
+  const bool shape_free = std::any_of(fit.parameters.begin(), fit.parameters.end(),
+                                      [&](const ParameterEstimate& p) { return !p.fixed && ShapeParameter(p.name); });
+  double nearest_mm = HUGE_VAL, farthest_mm = 0.0;
+  for (size_t v = 0; v < fit.poses.size(); ++v) {
+    if (!fit.view_left_out[v].empty()) continue;  // its pose was not fitted
+    nearest_mm = std::min(nearest_mm, fit.poses[v].camera_from_target_translation_mm.norm());
+    farthest_mm = std::max(farthest_mm, fit.poses[v].camera_from_target_translation_mm.norm());
+  }
+  record.nearest_target_mm = nearest_mm, record.farthest_target_mm = farthest_mm;
+  if (shape_free && farthest_mm < kOneDistanceRatio * nearest_mm) {
+    char text[300];
+    std::snprintf(text, sizeof text,
+                  "all targets are at one distance (%.0f-%.0f mm from the lens) while the mirror shape is free: the shape "
+                  "is weakly determined; add views at least %.1fx nearer or farther, or fix it (--fix shape)",
+                  nearest_mm, farthest_mm, kOneDistanceRatio);
+    warnings.push_back({WarningCode::kOneDistance, "", text});
+  }
+  // Views the fit left out, and why (their corners are in the report, marked dropped;
+  // those of boards of another size are not in the report).
+  for (const auto& [image, why] : record.views_left_out)
+    warnings.push_back({WarningCode::kViewLeftOut, image, image + ": view left out of the fit: " + why});
+  for (size_t v = 0; v < usable.images.size(); ++v)
+    if (!fit.view_left_out[v].empty()) {
+      warnings.push_back({WarningCode::kViewLeftOut, usable.images[v].image,
+                          usable.images[v].image + ": view left out of the fit: " + fit.view_left_out[v]});
+      record.views_left_out[usable.images[v].image] = fit.view_left_out[v];
+    }
+  for (const std::string& conflict : fit.tolerance_conflicts) warnings.push_back({WarningCode::kToleranceConflict, "", conflict});
+  for (const std::string& note : fit.tolerance_notes) warnings.push_back({WarningCode::kToleranceNote, "", note});
+  record.outlier_threshold_px = fit.outlier_threshold_px;
+  for (size_t v = 0; v < usable.images.size(); ++v) record.per_view_outliers[usable.images[v].image] = fit.per_view_outliers[v];
+  record.sigma_px = fit.sigma_px;
+  record.tolerances = fit_options.tolerances;
+  record.guess_rim_radius_mm = guess.rim_radius_mm();
+  record.fitted_rim_radius_mm = fit.sensor->rim_radius_mm();
+  if (fit.covariance_ok) record.covariance_names = fit.covariance_names, record.covariance = fit.covariance;
+
+  // The error at the user's distances: the covariance through the projection over the
+  // observed field (calib/predicted_error.h). Default: the corners' median distance from
+  // their reflection points, and infinity.
+  const double rim_mm = guess.rim_radius_mm();  // n counts the start's (design) rim radii
+  if (fit.covariance_ok) {
+    std::vector<double> distances = options.distances_mm;
+    for (double n : options.distances_n) distances.push_back(n * rim_mm);
+    if (distances.empty()) {
+      if (const double median_mm = MedianCornerDistanceMm(*fit.sensor, input.target, usable, fit); std::isfinite(median_mm))
+        distances.push_back(median_mm);
+      distances.push_back(kInfinityMm);
+    }
+    DetectionSet fitted = usable;  // the field the fit saw: its fitted views
+    fitted.images.clear();
+    for (size_t v = 0; v < usable.images.size(); ++v)
+      if (fit.view_left_out[v].empty()) fitted.images.push_back(usable.images[v]);
+    const std::vector<Eigen::Vector2d> field =
+        FieldPixels(*fit.sensor, FieldOfCorners(*fit.sensor, fitted), options.predicted_error_step_px);
+    predicted = PredictProjectionError(*fit.sensor, fit, field, distances);
+    for (const PredictedError& map : predicted) {
+      const bool infinite = map.distance_mm >= kInfinityMm;
+      char label[80];
+      if (infinite) {
+        std::snprintf(label, sizeof label, "infinity");
+      } else {
+        std::snprintf(label, sizeof label, "%.0f mm (n = %.2f)", map.distance_mm, map.distance_mm / rim_mm);
+      }
+      distance_labels.push_back(label);
+      record.predicted_error.push_back({map.distance_mm, infinite ? HUGE_VAL : map.distance_mm / rim_mm, map.median_px, map.max_px,
+                                        static_cast<int>(map.pixels.size()), map.unpredicted});
+      if (!std::isfinite(map.max_px))
+        warnings.push_back({WarningCode::kPredictedErrorUnknown, "",
+                            std::string("the projection error at ") + label + " could not be predicted (no field pixel projects)"});
+      if (map.max_px > options.max_predicted_error_px) {
+        // What would help: the valleys the data leave open (docs/calibrate.md "When the
+        // predicted error warning fires").
+        std::vector<std::string> help;
+        if (farthest_mm < kOneDistanceRatio * nearest_mm) help.push_back("boards at other distances");
+        const bool distortion_free = std::any_of(fit.parameters.begin(), fit.parameters.end(), [](const ParameterEstimate& p) {
+          return (p.name == "k1" || p.name == "k2") && !p.fixed;
+        });
+        if (distortion_free) help.push_back("the distortion held (--fix distortion)");
+        if (fit_options.tolerances.empty()) help.push_back("design tolerances (--tolerance)");
+        help.push_back("more views over the whole field");
+        std::string joined;
+        for (size_t k = 0; k < help.size(); ++k) joined += (k ? (k + 1 == help.size() ? " or " : ", ") : "") + help[k];
+        char text[400];
+        std::snprintf(text, sizeof text,
+                      "predicted projection error up to %.2f px (median %.2f) at %s exceeds %.2f px: the calibration "
+                      "may misplace objects there by that much; %s would help",
+                      map.max_px, map.median_px, label, options.max_predicted_error_px, joined.c_str());
+        warnings.push_back({WarningCode::kPredictedErrorHigh, "", text});
+      }
+    }
+  }
+  for (const CalibrationWarning& w : warnings)
+    if (w.code != WarningCode::kViewSkipped && w.code != WarningCode::kImageUnreadable &&
+        w.code != WarningCode::kImageSizeDiffers && w.code != WarningCode::kCheckerboardRefused)
+      record.warnings.push_back(w.text);
+  for (size_t v = 0; v < usable.images.size(); ++v) record.per_view_rms_px[usable.images[v].image] = fit.per_view_rms_px[v];
+  record.parameters = fit.parameters;
+  for (size_t v = 0; v < usable.images.size(); ++v)
+    if (fit.view_left_out[v].empty()) record.poses[usable.images[v].image] = fit.poses[v];
+
+  const Sensor fitted = *fit.sensor;
+  return CalibrationResult{fitted,
+                           std::move(record),
+                           std::move(fit),
+                           from_images ? std::move(detections) : DetectionSet(),
+                           std::move(views.detections),
+                           std::move(predicted),
+                           std::move(distance_labels),
+                           std::move(warnings)};
+}
+
+}  // namespace omnical

@@ -1,0 +1,76 @@
+// The calibration pipeline as one call: corners (detected here from images, or given),
+// the starting sensor (a guess, converted to another mirror family if asked, or the
+// mirror's rim circle), the checks that the views can determine the sensor, the robust
+// staged bundle fit, a second detection pass through the first fit (aprilgrid from
+// images), boards of the wrong size refused, optionally leave-one-out, the predicted
+// projection error at the user's distances, and every warning as a typed code plus text.
+// No printing and no files written: calibration_json.h writes (and reads back) the record,
+// calib/report/ the figures.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "calib/bundle_fit.h"
+#include "calib/calibration_record.h"
+#include "calib/calibration_warning.h"
+#include "calib/design_tolerances.h"
+#include "calib/image_detection.h"
+#include "calib/initial_sensor.h"
+#include "calib/predicted_error.h"
+#include "calib/target.h"
+#include "model/progress.h"
+#include "model/sensor.h"
+
+namespace omnical {
+
+struct CalibrationInput {
+  CalibrationTarget target;
+  std::string target_name;  // the spec file (detections refer to it; messages name it)
+  // The corners: exactly one of image files (detected here), images in memory, or detections.
+  std::vector<std::string> image_paths;
+  std::vector<NamedImage> images;
+  std::optional<DetectionSet> detections;
+  std::string source;  // what the corners came from, named in messages (a directory, a file)
+  // The starting sensor: a guess with its design tolerances, or none (the rim circle).
+  std::optional<Sensor> guess;
+  std::string guess_name;  // its file, named in messages and in the record's "start"
+  DesignTolerances guess_tolerances;
+};
+
+struct CalibrationOptions {
+  std::string profile;  // mirror family to fit ("": the guess's; polynomial without a guess)
+  double rim_field_deg = kDefaultRimFieldDeg;
+  std::set<std::string> fixed;  // FitOptions::fixed block names
+  double loss_px = 1.0;
+  int max_iterations = 200;
+  int detection_passes = 2;
+  int threads = 1;  // detection
+  bool leave_one_out = false;
+  DesignTolerances tolerances;  // added to / overriding the guess's
+  std::vector<double> distances_mm, distances_n;  // for the predicted error (n: design rim radii)
+  double max_predicted_error_px = 0.3;
+  double predicted_error_step_px = 16.0;  // grid of the predicted-error maps
+  ProgressCallback progress;
+  std::string Check() const;  // "" or "field: problem"
+};
+
+struct CalibrationResult {
+  Sensor sensor;               // the fitted sensor
+  CalibrationRecord record;    // what calibration.json holds (calibration_json.h)
+  FitResult fit;               // per corner residuals, for the report
+  DetectionSet detections;     // every detected corner (empty when detections were given)
+  DetectionSet views;          // the views given to the fit, in FitResult's order (see fit.view_left_out)
+  std::vector<PredictedError> predicted;  // one map per distance
+  std::vector<std::string> distance_labels;
+  std::vector<CalibrationWarning> warnings;  // detection's and the fit's, in order
+};
+
+// Throws InputError naming the field or input that cannot work (too few views, one pose,
+// image size, a failed fit), Cancelled if the progress callback asked to stop.
+CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOptions& options);
+
+}  // namespace omnical

@@ -1,0 +1,60 @@
+// What a calibration run reports, exactly as calibration.json holds it: written by
+// WriteCalibrationJson and read back by ReadCalibrationJson (calib/calibration_json.h).
+// The fitted sensor itself is in sensor.yaml.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "calib/bundle_fit.h"
+#include "calib/design_tolerances.h"
+
+namespace omnical {
+
+struct CalibrationRecord {
+  double rms_px = 0.0;  // per corner, sqrt(mean |e|^2), over the inliers
+  bool converged = false;
+  int outliers = 0, dropped = 0, unrefined_corners_left_out = 0, observations = 0;
+  std::string solver_report;
+  std::set<std::string> fixed_blocks;
+  double robust_loss_px = 0.0;
+  bool covariance_ok = false;
+  std::string start;  // where the fit started: the guess file, or the rim circle
+  int detection_passes = 1;
+  struct RimCircleRecord {
+    Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
+    double radius_px = 0.0, inlier_fraction = 0.0, rms_px = 0.0;
+  };
+  std::optional<RimCircleRecord> rim_circle;
+  struct Spread {
+    double min = 0.0, max = 0.0, std = 0.0;
+  };
+  std::map<std::string, Spread> leave_one_out;  // per parameter; empty unless asked
+  double nearest_target_mm = 0.0, farthest_target_mm = 0.0;  // fitted views, from the lens
+  std::map<std::string, std::string> views_left_out;          // image -> why
+  double outlier_threshold_px = 0.0;
+  std::map<std::string, int> per_view_outliers;  // image -> corners cut
+  double sigma_px = 0.0;
+  DesignTolerances tolerances;
+  double guess_rim_radius_mm = 0.0, fitted_rim_radius_mm = 0.0;
+  std::vector<std::string> covariance_names;  // empty unless covariance_ok
+  Eigen::MatrixXd covariance;
+  struct PredictedErrorSummary {
+    double distance_mm = 0.0;  // kInfinityMm (predicted_error.h) for infinity
+    double n_rim_radii = 0.0;  // distance in the start's rim radii (HUGE_VAL for infinity)
+    double median_px = 0.0, max_px = 0.0;
+    int field_pixels = 0, unpredicted_pixels = 0;
+  };
+  std::vector<PredictedErrorSummary> predicted_error;
+  std::vector<std::string> warnings;  // the texts (the codes are in CalibrationResult)
+  std::map<std::string, double> per_view_rms_px;  // image -> RMS
+  std::vector<ParameterEstimate> parameters;      // in the fit's order
+  std::map<std::string, TargetPose> poses;        // fitted views: image -> camera_from_target
+};
+
+}  // namespace omnical

@@ -1,0 +1,34 @@
+// What a detection or calibration run found questionable without failing: a typed code a
+// program can act on, the image or parameter it concerns, and the one-line text a person
+// reads (the CLI prints it after "omnical: warning: ").
+#pragma once
+
+#include <string>
+
+namespace omnical {
+
+enum class WarningCode {
+  kImageUnreadable,           // subject: the image; skipped
+  kImageSizeDiffers,          // subject: the image; skipped
+  kCheckerboardRefused,       // subject: the image; a checkerboard-like grid that is not the target
+  kViewSkipped,               // subject: the image; too few usable corners for a starting pose
+  kToleranceNotApplicable,    // subject: the parameter; the guess's tolerance does not fit the family
+  kViewLeftOut,               // subject: the image; left out of the fit (why in the text)
+  kSensorInvalid,             // the fitted sensor fails validation
+  kNotConverged,              // the solver did not converge
+  kFreeGauge,                 // the covariance could not be computed
+  kWeaklyDetermined,          // subject: the parameter
+  kOneDistance,               // every board at about one distance while the shape is free
+  kToleranceConflict,         // a parameter ended far from its design value
+  kToleranceNote,             // a tolerance the fit could not use
+  kPredictedErrorUnknown,     // no field pixel projects at a distance
+  kPredictedErrorHigh,        // the predicted projection error exceeds the threshold
+};
+
+struct CalibrationWarning {
+  WarningCode code;
+  std::string subject;  // image path or parameter name; empty if about the whole run
+  std::string text;     // one line, complete
+};
+
+}  // namespace omnical

@@ -1,0 +1,122 @@
+#include "calib/image_detection.h"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <atomic>
+#include <functional>
+#include <thread>
+
+#include "calib/detect.h"
+#include "calib/image_file.h"
+#include "calib/refine_corners.h"
+#include "model/input_error.h"
+
+namespace omnical {
+namespace {
+
+struct OneImage {
+  ImageDetections found;
+  cv::Size size;
+  std::string problem;  // why it is skipped
+  std::optional<RimCircle> circle;
+  std::vector<std::string> refusals;  // checkerboard candidates refused
+};
+
+void DetectOne(const CalibrationTarget& target, const cv::Mat& grey, const DetectionOptions& options, OneImage* out) {
+  if (grey.empty()) {
+    out->problem = "cannot read the image";
+    return;
+  }
+  out->size = grey.size();
+  const bool checkerboard = target.type() == CalibrationTarget::Type::kCheckerboard;
+  if (checkerboard) {
+    std::vector<CheckerboardCandidate> candidates;
+    out->found = DetectCheckerboard(target, grey, &candidates);
+    for (const CheckerboardCandidate& c : candidates)
+      if (!c.accepted) out->refusals.push_back(c.refusal);
+  } else {
+    out->found = DetectTarget(target, grey);
+  }
+  const Sensor* guess = options.guess && grey.cols == options.guess->image_width_px() &&
+                                grey.rows == options.guess->image_height_px()
+                            ? &*options.guess
+                            : nullptr;
+  if (guess && target.type() == CalibrationTarget::Type::kAprilGrid)
+    out->found = DetectThroughVirtualViews(target, grey, *guess, out->found);
+  if (checkerboard ? options.refine_checkerboards : options.refine)
+    out->found = RefineCorners(target, grey, guess, out->found);
+  if (options.rim_circles) out->circle = DetectRimCircle(grey);
+}
+
+// Detects image i of `count` (get(i) gives its pixels, name(i) its name) on
+// options.threads threads, then collects the results in order.
+DetectedImages DetectAll(const CalibrationTarget& target, size_t count, const std::function<cv::Mat(size_t)>& get,
+                         const std::function<std::string(size_t)>& name, const std::string& source,
+                         const DetectionOptions& options) {
+  if (const std::string why = options.Check(); !why.empty()) throw InputError(why);
+  std::vector<OneImage> images(count);
+  std::atomic<size_t> next{0};
+  ProgressReporter progress(options.progress, "detect", static_cast<long>(count));
+  auto work = [&]() {
+    for (size_t i = next++; i < count; i = next++) {
+      DetectOne(target, get(i), options, &images[i]);
+      images[i].found.image = name(i);
+      if (!progress.Advance()) return;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < options.threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  progress.ThrowIfCancelled();
+
+  DetectedImages out;
+  for (size_t i = 0; i < count; ++i) {
+    OneImage& image = images[i];
+    if (image.problem.empty() && out.detections.images.empty()) {
+      out.detections.image_width_px = image.size.width;
+      out.detections.image_height_px = image.size.height;
+    }
+    if (image.problem.empty() && image.size != cv::Size(out.detections.image_width_px, out.detections.image_height_px))
+      image.problem = "its size differs from the first image's";
+    for (const std::string& why : image.refusals)
+      out.warnings.push_back({WarningCode::kCheckerboardRefused, name(i), name(i) + ": a checkerboard-like grid refused: " + why});
+    if (!image.problem.empty()) {
+      out.warnings.push_back({image.size.empty() ? WarningCode::kImageUnreadable : WarningCode::kImageSizeDiffers, name(i),
+                              name(i) + ": " + image.problem + ", skipped"});
+      continue;
+    }
+    out.detections.images.push_back(std::move(image.found));
+    if (image.circle) out.rim_circles.push_back(*image.circle);
+  }
+  if (out.detections.images.empty()) throw InputError(InputMessage(source, "images", "no readable image"));
+  return out;
+}
+
+}  // namespace
+
+std::string DetectionOptions::Check() const {
+  if (threads < 1) return "threads: must be >= 1 (got " + std::to_string(threads) + ")";
+  if (guess)
+    if (const std::string why = ValidateSensorModel(guess->model()); !why.empty()) return "guess: " + why;
+  return "";
+}
+
+DetectedImages DetectImageFiles(const CalibrationTarget& target, const std::vector<std::string>& paths,
+                                const std::string& source, const DetectionOptions& options) {
+  return DetectAll(
+      target, paths.size(), [&](size_t i) { return ReadImageFile(paths[i], cv::IMREAD_GRAYSCALE); },
+      [&](size_t i) { return paths[i]; }, source, options);
+}
+
+DetectedImages DetectImages(const CalibrationTarget& target, const std::vector<NamedImage>& images,
+                            const DetectionOptions& options) {
+  for (const NamedImage& image : images)
+    if (!image.grey.empty() && image.grey.type() != CV_8UC1)
+      throw InputError(InputMessage(image.name, "image", "must be 8-bit grey (one channel)"));
+  return DetectAll(
+      target, images.size(), [&](size_t i) { return images[i].grey; }, [&](size_t i) { return images[i].name; },
+      "images", options);
+}
+
+}  // namespace omnical

@@ -1,0 +1,50 @@
+// The target's corners in many omni images: parallel, with progress through a callback;
+// an unreadable image or one of another size is reported (a warning) and skipped.
+// Optionally the mirror's rim circle of every image (calibration without a guess starts
+// from it). Images come as files or as cv::Mat.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "calib/calibration_warning.h"
+#include "calib/detections.h"
+#include "calib/rim_circle.h"
+#include "calib/target.h"
+#include "model/progress.h"
+#include "model/sensor.h"
+
+namespace omnical {
+
+struct DetectionOptions {
+  std::optional<Sensor> guess;        // aprilgrid: virtual views and patch refinement through it
+  bool refine = true;                 // aprilgrid corners (calib/refine_corners.h)
+  bool refine_checkerboards = false;  // see calib/refine_corners.h: better on renders, worse on real images
+  bool rim_circles = false;
+  int threads = 1;
+  ProgressCallback progress;  // stage "detect", one step per image
+  std::string Check() const;  // "" or "field: problem"
+};
+
+struct DetectedImages {
+  DetectionSet detections;                  // target_spec is left to the caller
+  std::vector<RimCircle> rim_circles;       // of the images where one was found
+  std::vector<CalibrationWarning> warnings;  // images skipped, grids refused
+};
+
+// An image in memory and the name it is reported under (its path, or any label).
+struct NamedImage {
+  std::string name;
+  cv::Mat grey;  // 8-bit, one channel
+};
+
+// Throws InputError naming `source` (the directory or pattern) if no image could be read.
+DetectedImages DetectImageFiles(const CalibrationTarget& target, const std::vector<std::string>& paths,
+                                const std::string& source, const DetectionOptions& options);
+DetectedImages DetectImages(const CalibrationTarget& target, const std::vector<NamedImage>& images,
+                            const DetectionOptions& options);
+
+}  // namespace omnical

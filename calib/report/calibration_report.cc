@@ -1,0 +1,112 @@
+#include "calib/report/calibration_report.h"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "calib/image_file.h"
+#include "calib/report/plot.h"
+#include "model/atomic_write.h"
+
+namespace omnical {
+namespace {
+
+// A map of the predicted projection error over the observed field, one cell per grid pixel.
+void WritePredictedErrorMap(const std::string& path, const Sensor& sensor, const PredictedError& map, double step_px,
+                            double threshold_px, const std::string& label) {
+  cv::Mat picture(sensor.image_height_px(), sensor.image_width_px(), CV_8UC3, cv::Scalar(30, 30, 30));
+  // Colour scale from 0 to the larger of the worst value and the warning threshold, so a
+  // map under the threshold never looks alarming.
+  const double top = std::max(threshold_px, map.max_px);
+  for (size_t k = 0; k < map.pixels.size(); ++k) {
+    if (!std::isfinite(map.std_px[k])) continue;
+    cv::Mat level(1, 1, CV_8U, cv::Scalar(static_cast<int>(std::lround(255.0 * std::min(1.0, map.std_px[k] / top)))));
+    cv::Mat colour;
+    cv::applyColorMap(level, colour, cv::COLORMAP_VIRIDIS);
+    const cv::Vec3b c = colour.at<cv::Vec3b>(0, 0);
+    const cv::Point2d corner(map.pixels[k].x() - 0.5 * step_px, map.pixels[k].y() - 0.5 * step_px);
+    cv::rectangle(picture, cv::Rect2d(corner, cv::Size2d(step_px, step_px)), cv::Scalar(c[0], c[1], c[2]), cv::FILLED);
+  }
+  char text[200];
+  std::snprintf(text, sizeof text, "predicted error at %s: median %.3f px, worst %.3f px", label.c_str(), map.median_px,
+                map.max_px);
+  cv::putText(picture, text, {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  std::snprintf(text, sizeof text, "colour: 0 (purple) to %.3f px (yellow); warning above %.2f px", top, threshold_px);
+  cv::putText(picture, text, {10, 48}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  WritePng(path, picture);
+}
+
+void WriteReport(const std::filesystem::path& dir, const DetectionSet& detections, const FitResult& fit) {
+  CreateOutputDirectory(dir);
+  double worst = 0.0;
+  std::vector<double> magnitudes;
+  for (const auto& view : fit.residuals_px)
+    for (const Eigen::Vector2d& r : view)
+      if (std::isfinite(r.x())) magnitudes.push_back(r.norm()), worst = std::max(worst, r.norm());
+  // Residual vectors on each image, scaled so the largest is ~40 px long.
+  const double scale = worst > 0.0 ? std::pow(10.0, std::floor(std::log10(40.0 / worst))) : 1.0;
+  cv::Mat coverage(detections.image_height_px, detections.image_width_px, CV_8UC3, cv::Scalar(30, 30, 30));
+  for (size_t v = 0; v < detections.images.size(); ++v) {
+    const ImageDetections& image = detections.images[v];
+    cv::Mat picture = ReadImageFile(image.image, cv::IMREAD_COLOR);
+    if (picture.empty()) picture = cv::Mat(detections.image_height_px, detections.image_width_px, CV_8UC3, cv::Scalar(40, 40, 40));
+    for (size_t i = 0; i < image.corners.size(); ++i) {
+      const cv::Point2d p(image.corners[i].pixel.x(), image.corners[i].pixel.y());
+      cv::circle(coverage, p, 2, SeriesColor(static_cast<int>(v)), cv::FILLED);
+      const Eigen::Vector2d& r = fit.residuals_px[v][i];
+      if (!std::isfinite(r.x())) {
+        cv::drawMarker(picture, p, cv::Scalar(0, 0, 255), cv::MARKER_TILTED_CROSS, 8, 1);  // dropped
+        continue;
+      }
+      cv::circle(picture, p, 2, cv::Scalar(0, 200, 0), cv::FILLED);
+      cv::line(picture, p, p + cv::Point2d(r.x(), r.y()) * scale, cv::Scalar(0, 140, 255), 1, cv::LINE_AA);
+    }
+    char legend[160];
+    std::snprintf(legend, sizeof legend, "residuals x%g (orange), RMS %.3f px; red crosses: dropped", scale,
+                  fit.per_view_rms_px[v]);
+    cv::putText(picture, legend, {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+    WritePng((dir / ("residuals_view" + std::to_string(v) + ".png")).string(), picture);
+  }
+  cv::putText(coverage, "detected corners, one colour per view", {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.6,
+              cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  WritePng((dir / "coverage.png").string(), coverage);
+
+  // Histogram of residual magnitudes and per-view RMS, drawn as steps.
+  const int bins = 30;
+  const double width = worst > 0.0 ? worst / bins : 1.0;
+  std::vector<double> counts(bins, 0.0);
+  for (double m : magnitudes) counts[std::min(bins - 1, static_cast<int>(m / width))] += 1.0;
+  std::vector<double> x, y;
+  for (int b = 0; b < bins; ++b) {
+    x.insert(x.end(), {b * width, b * width, (b + 1) * width, (b + 1) * width});
+    y.insert(y.end(), {0.0, counts[b], counts[b], 0.0});
+  }
+  PlotPanel histogram("Residual magnitudes", "|residual| (px)", "corners");
+  histogram.series.push_back(PlotSeries("", x, y, SeriesColor(0)));
+  WritePng((dir / "residual_histogram.png").string(), RenderPanel(histogram, 800, 500));
+  x.clear(), y.clear();
+  for (size_t v = 0; v < fit.per_view_rms_px.size(); ++v) {
+    x.insert(x.end(), {v - 0.4, v - 0.4, v + 0.4, v + 0.4});
+    y.insert(y.end(), {0.0, fit.per_view_rms_px[v], fit.per_view_rms_px[v], 0.0});
+  }
+  PlotPanel per_view("RMS reprojection error per view", "view", "RMS (px)");
+  per_view.series.push_back(PlotSeries("", x, y, SeriesColor(1)));
+  WritePng((dir / "per_view_rms.png").string(), RenderPanel(per_view, 800, 500));
+}
+
+}  // namespace
+
+void WriteCalibrationReport(const std::string& dir, const CalibrationResult& result, const CalibrationOptions& options) {
+  const std::filesystem::path path(dir);
+  WriteReport(path, result.views, result.fit);
+  for (size_t k = 0; k < result.predicted.size(); ++k)
+    WritePredictedErrorMap((path / ("predicted_error_" + std::to_string(k) + ".png")).string(), result.sensor,
+                           result.predicted[k], options.predicted_error_step_px, options.max_predicted_error_px,
+                           result.distance_labels[k]);
+}
+
+}  // namespace omnical

@@ -1,0 +1,105 @@
+#!/usr/bin/env python3
+"""Fails when a source file includes a header from a layer it may not use (docs/layers.md).
+
+Usage: layers_test.py SOURCE_DIR            check the tree
+       layers_test.py SOURCE_DIR --self-test  also check that planted violations are caught
+"""
+import os
+import re
+import shutil
+import sys
+import tempfile
+
+INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
+# Third-party header prefixes we police (the standard library and system headers pass).
+THIRD_PARTY = {"Eigen": "Eigen", "unsupported": "Eigen", "ceres": "ceres", "boost": "boost", "yaml-cpp": "yaml-cpp",
+               "nlohmann": "nlohmann", "opencv2": "opencv2", "apriltag": "apriltag", "CLI": "CLI", "gtest": "gtest",
+               "gmock": "gmock", "benchmark": "benchmark", "glog": "ceres", "gflags": "ceres"}
+
+
+def read_table(root):
+    layers = []  # (name, directory, allowed layers, allowed third-party)
+    with open(os.path.join(root, "docs", "layers.md")) as f:
+        for line in f:
+            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            if len(cells) != 5 or cells[0] in ("layer", "") or set(cells[0]) <= set("-"):
+                continue
+            allowed = {c.strip() for c in cells[3].split(",") if c.strip()} | {cells[0]}
+            third = {c.strip() for c in cells[4].split(",") if c.strip()}
+            layers.append((cells[0], cells[1].rstrip("/") + "/", allowed, third))
+    if not layers:
+        sys.exit("layers_test: no layer table in docs/layers.md")
+    return layers
+
+
+def layer_of(path, layers):
+    best = None
+    for layer in layers:
+        if path.startswith(layer[1]) and (best is None or len(layer[1]) > len(best[1])):
+            best = layer
+    return best
+
+
+def check(root, layers):
+    problems = []
+    for name, directory, _, _ in layers:
+        for folder, _, files in os.walk(os.path.join(root, directory)):
+            for file in files:
+                if not file.endswith((".h", ".cc", ".cpp", ".hpp")):
+                    continue
+                path = os.path.relpath(os.path.join(folder, file), root)
+                own = layer_of(path, layers)
+                if own[0] != name:
+                    continue  # a deeper layer's file, checked under its own row
+                with open(os.path.join(root, path), errors="replace") as f:
+                    text = f.read()
+                for match in INCLUDE.finditer(text):
+                    header = match.group(2)
+                    if match.group(1) == '"':
+                        target = layer_of(header, layers)
+                        if target is None:
+                            if os.path.exists(os.path.join(root, header)):
+                                problems.append(f"{path}: includes {header}, which belongs to no layer")
+                            continue
+                        if target[0] not in own[2]:
+                            problems.append(f"{path}: layer {name} may not include {header} (layer {target[0]})")
+                    else:
+                        prefix = header.split("/")[0]
+                        library = THIRD_PARTY.get(prefix)
+                        if library and library not in own[3]:
+                            problems.append(f"{path}: layer {name} may not use <{header}> ({library})")
+    return problems
+
+
+def self_test(root, layers):
+    """The checker must catch a planted bad edge and a planted third-party header."""
+    with tempfile.TemporaryDirectory() as tmp:
+        os.makedirs(os.path.join(tmp, "docs"))
+        shutil.copy(os.path.join(root, "docs", "layers.md"), os.path.join(tmp, "docs"))
+        for directory in ("model", "calib", "correction"):
+            os.makedirs(os.path.join(tmp, directory))
+        open(os.path.join(tmp, "calib", "a.h"), "w").write("#pragma once\n")
+        open(os.path.join(tmp, "correction", "b.cc"), "w").write('#include "calib/a.h"\n')
+        open(os.path.join(tmp, "model", "c.cc"), "w").write("#include <opencv2/core.hpp>\n")
+        found = check(tmp, read_table(tmp))
+        expected = ["correction/b.cc: layer correction may not include calib/a.h (layer calib)",
+                    "model/c.cc: layer model may not use <opencv2/core.hpp> (opencv2)"]
+        if sorted(found) != expected:
+            sys.exit("layers_test self-test: expected %s, got %s" % (expected, found))
+
+
+def main():
+    root = sys.argv[1]
+    layers = read_table(root)
+    if "--self-test" in sys.argv:
+        self_test(root, layers)
+    problems = check(root, layers)
+    for p in problems:
+        print(p)
+    if problems:
+        sys.exit(f"layers_test: {len(problems)} include(s) cross the layer table (docs/layers.md)")
+    print(f"layers_test: {len(layers)} layers, every include allowed")
+
+
+if __name__ == "__main__":
+    main()
