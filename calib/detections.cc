@@ -9,28 +9,12 @@
 
 #include "model/atomic_write.h"
 #include "model/input_error.h"
+#include "model/json_file.h"
 
 namespace omnical {
-namespace {
-
-nlohmann::json ReadJson(const std::string& path) {
-  // A directory opens as a stream, then throws std::ios_failure inside the parser.
-  if (std::filesystem::is_directory(path)) throw InputError(InputMessage(path, "", "is a directory, not a file"));
-  std::ifstream file(path);
-  if (!file) throw InputError(InputMessage(path, "", std::filesystem::exists(path) ? "cannot read" : "file not found"));
-  try {
-    return nlohmann::json::parse(file);
-  } catch (const nlohmann::json::exception& error) {
-    throw InputError(InputMessage(path, "", std::string("malformed JSON: ") + error.what()));
-  } catch (const std::exception& error) {
-    throw InputError(InputMessage(path, "", std::string("cannot read: ") + error.what()));
-  }
-}
-
-}  // namespace
 
 DetectionSet ReadDetections(const std::string& path) {
-  const nlohmann::json json = ReadJson(path);
+  const nlohmann::json json = ReadJsonFile(path);
   DetectionSet set;
   try {
     set.target_spec = json.at("target").get<std::string>();
@@ -81,30 +65,5 @@ void WriteDetections(const DetectionSet& detections, const std::string& path) {
   WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(1) << '\n'; });
 }
 
-DetectionSet DetectionsFromGroundTruth(const std::vector<std::string>& truth_paths) {
-  DetectionSet set;
-  for (const std::string& path : truth_paths) {
-    const nlohmann::json json = ReadJson(path);
-    try {
-      set.image_width_px = json.at("image_size").at(0).get<int>();
-      set.image_height_px = json.at("image_size").at(1).get<int>();
-      for (const nlohmann::json& target : json.at("targets")) {
-        // A relative spec is relative to the ground-truth file (omnical render writes it so).
-        const std::filesystem::path spec = target.at("spec").get<std::string>();
-        set.target_spec = (spec.is_absolute() ? spec : std::filesystem::path(path).parent_path() / spec).lexically_normal().string();
-        ImageDetections image;
-        image.image = (std::filesystem::path(path).parent_path() / json.at("image").get<std::string>()).string();
-        for (const nlohmann::json& corner : target.at("corners"))
-          if (corner.at("visible").get<bool>())
-            image.corners.push_back({corner.at("id").get<int>(),
-                                     Eigen::Vector2d(corner.at("pixel").at(0).get<double>(), corner.at("pixel").at(1).get<double>())});
-        set.images.push_back(std::move(image));
-      }
-    } catch (const nlohmann::json::exception& error) {
-      throw InputError(InputMessage(path, "", std::string("not a ground-truth file: ") + error.what()));
-    }
-  }
-  return set;
-}
 
 }  // namespace omnical

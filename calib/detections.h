@@ -1,5 +1,6 @@
 // Detected target corners per image: what `omnical detect` writes and `omnical
-// calibrate` reads (JSON). A rendered view's ground truth converts to the same form.
+// calibrate` reads (JSON). A rendered view's ground truth converts to the same form
+// (calib/synthetic/ground_truth.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -34,8 +35,5 @@ struct DetectionSet {
 // file and the entry; write is atomic.
 DetectionSet ReadDetections(const std::string& path);
 void WriteDetections(const DetectionSet& detections, const std::string& path);
-
-// The visible corners of rendered views (omnical render's <view>.json files).
-DetectionSet DetectionsFromGroundTruth(const std::vector<std::string>& truth_paths);
 
 }  // namespace omnical

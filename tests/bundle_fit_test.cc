@@ -8,7 +8,7 @@
 #include <random>
 
 #include "calib/bundle_fit.h"
-#include "correction/renderer.h"
+#include "calib/synthetic/renderer.h"
 #include "test_sensors.h"
 
 namespace omnical {

@@ -14,7 +14,7 @@
 #include "calib/board_scale.h"
 #include "calib/bundle_fit.h"
 #include "calib/predicted_error.h"
-#include "correction/renderer.h"
+#include "calib/synthetic/renderer.h"
 #include "test_sensors.h"
 
 namespace omnical {

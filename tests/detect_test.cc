@@ -15,8 +15,9 @@
 
 #include "calib/checkerboard_candidates.h"
 #include "calib/detect.h"
+#include "calib/synthetic/ground_truth.h"
 #include "calib/refine_corners.h"
-#include "correction/renderer.h"
+#include "calib/synthetic/renderer.h"
 #include "test_sensors.h"
 
 namespace omnical {

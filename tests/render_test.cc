@@ -8,7 +8,7 @@
 #include <cmath>
 #include <random>
 
-#include "correction/renderer.h"
+#include "calib/synthetic/renderer.h"
 #include "test_sensors.h"
 
 namespace omnical {

@@ -6,7 +6,7 @@
 #include <fstream>
 
 #include "calib/detections.h"
-#include "correction/scene.h"
+#include "calib/synthetic/scene.h"
 #include "model/input_error.h"
 #include "model/sensor.h"
 #include "test_sensors.h"

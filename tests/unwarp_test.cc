@@ -18,7 +18,7 @@
 #include "calib/detect.h"
 #include "calib/refine_corners.h"
 #include "correction/remap_table.h"
-#include "correction/renderer.h"
+#include "calib/synthetic/renderer.h"
 #include "correction/viewpoint_error.h"
 #include "model/optics.h"
 #include "test_sensors.h"

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "calib/detect.h"
+#include "calib/synthetic/ground_truth.h"
 #include "calib/refine_corners.h"
 #include "model/atomic_write.h"
 

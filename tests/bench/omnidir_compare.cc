@@ -17,6 +17,7 @@
 
 #include "calib/bundle_fit.h"
 #include "calib/detect.h"
+#include "calib/synthetic/ground_truth.h"
 #include "correction/viewpoint_error.h"
 #include "model/atomic_write.h"
 

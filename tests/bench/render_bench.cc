@@ -6,7 +6,7 @@
 
 #include <thread>
 
-#include "correction/renderer.h"
+#include "calib/synthetic/renderer.h"
 
 namespace omnical {
 namespace {

@@ -18,7 +18,7 @@
 #include "calib/detections.h"
 #include "calib/target.h"
 #include "correction/map_export.h"
-#include "correction/scene.h"
+#include "calib/synthetic/scene.h"
 #include "model/csv_reader.h"
 #include "model/design_spec_yaml.h"
 #include "model/input_error.h"

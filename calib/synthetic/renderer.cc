@@ -1,4 +1,4 @@
-#include "correction/renderer.h"
+#include "calib/synthetic/renderer.h"
 
 #include "correction/parallel_rows.h"
 

@@ -1,4 +1,4 @@
-#include "correction/scene.h"
+#include "calib/synthetic/scene.h"
 
 #include <Eigen/Geometry>
 #include <cmath>

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "correction/pixel_ray_grid.h"
-#include "correction/scene.h"
+#include "calib/synthetic/scene.h"
 
 namespace omnical {
 

@@ -1,0 +1,66 @@
+#include "calib/synthetic/render_scene.h"
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <filesystem>
+
+#include "calib/synthetic/ground_truth.h"
+#include "correction/pixel_ray_grid.h"
+#include "model/atomic_write.h"
+#include "model/input_error.h"
+
+namespace omnical {
+
+std::string RenderOptions::Check() const {
+  if (threads < 1) return "threads: must be >= 1 (got " + std::to_string(threads) + ")";
+  return "";
+}
+
+std::vector<RenderedView> RenderScene(const Scene& scene, const RenderOptions& options) {
+  if (const std::string why = options.Check(); !why.empty()) throw InputError(why);
+  const Sensor& sensor = *scene.sensor;
+  const PixelRayGrid rays(sensor, options.threads);
+  std::vector<RenderedView> rendered;
+  for (size_t k = 0; k < scene.views.size(); ++k) {
+    const SceneView& view = scene.views[k];
+    ProgressReporter progress(options.progress,
+                              "render " + view.name + " (" + std::to_string(k + 1) + "/" + std::to_string(scene.views.size()) + ")",
+                              sensor.image_height_px());
+    cv::Mat image = RenderView(sensor, rays, view, scene.environment, scene.formation, static_cast<unsigned>(k),
+                               options.threads, [&](long rows) { progress.Advance(rows); });
+    progress.ThrowIfCancelled();
+    rendered.push_back({&view, std::move(image), GroundTruth(sensor, view)});
+  }
+  return rendered;
+}
+
+void WriteRenderedScene(const Scene& scene, const std::string& scene_path, const std::vector<RenderedView>& views,
+                        const std::string& dir_name) {
+  const Sensor& sensor = *scene.sensor;
+  CreateOutputDirectory(dir_name);
+  const std::filesystem::path dir(dir_name);
+  const std::string sensor_yaml = SensorYamlText(sensor);
+  nlohmann::json index;
+  index["scene"] = std::filesystem::proximate(std::filesystem::absolute(scene_path), std::filesystem::absolute(dir)).string();
+  index["sensor_file"] = "sensor.yaml";
+  std::vector<std::vector<uchar>> pngs(views.size());
+  std::vector<std::string> truths(views.size());
+  for (size_t k = 0; k < views.size(); ++k) {
+    const SceneView& view = *views[k].view;
+    cv::imencode(".png", views[k].image, pngs[k], {cv::IMWRITE_PNG_COMPRESSION, 9});
+    truths[k] = GroundTruthJsonText(view, views[k].truth, dir_name, sensor_yaml, sensor);
+    index["views"].push_back({{"name", view.name}, {"image", view.name + ".png"}, {"truth", view.name + ".json"}});
+  }
+  for (size_t k = 0; k < views.size(); ++k) {
+    const std::vector<uchar>& png = pngs[k];
+    WriteFileAtomically((dir / (views[k].view->name + ".png")).string(), [&](std::ostream& out) {
+      out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
+    });
+    WriteFileAtomically((dir / (views[k].view->name + ".json")).string(), [&](std::ostream& out) { out << truths[k]; });
+  }
+  WriteFileAtomically((dir / "sensor.yaml").string(), [&](std::ostream& out) { out << sensor_yaml; });
+  WriteFileAtomically((dir / "scene.json").string(), [&](std::ostream& out) { out << index.dump(2) << '\n'; });
+}
+
+}  // namespace omnical

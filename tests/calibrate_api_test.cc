@@ -1,0 +1,157 @@
+// The calibration pipeline called as a library (calib/calibrate.h), no CLI: from the
+// committed render of the misaligned sphere (ohte-sph-misaligned-near, 8 views) through
+// its ground-truth corners, from images in memory, cancelled through the callback, and
+// calibration.json written and read back.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "calib/calibrate.h"
+#include "calib/calibration_json.h"
+#include "calib/image_file.h"
+#include "calib/synthetic/ground_truth.h"
+#include "test_sensors.h"
+
+namespace omnical {
+namespace {
+
+const std::string kSet = "/datasets-synthetic/rendered/ohte-sph-misaligned-near";
+
+std::vector<std::string> TruthFiles() {
+  std::vector<std::string> paths;
+  for (const std::string& image : ListImages(testing::SourceDir() + kSet))
+    paths.push_back(image.substr(0, image.size() - 4) + ".json");
+  return paths;
+}
+
+CalibrationInput InputFromTruth() {
+  CalibrationInput input;
+  input.target_name = testing::SourceDir() + "/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml";
+  input.target = CalibrationTarget::FromYaml(input.target_name);
+  input.detections = DetectionsFromGroundTruth(TruthFiles());
+  input.source = "ground truth";
+  input.guess_name = testing::SourceDir() + "/datasets-synthetic/sensors/ohte-sph-misaligned-guess.yaml";
+  input.guess = LoadSensorYaml(input.guess_name);
+  return input;
+}
+
+double Parameter(const CalibrationRecord& record, const std::string& name) {
+  for (const ParameterEstimate& p : record.parameters)
+    if (p.name == name) return p.value;
+  ADD_FAILURE() << "no parameter " << name;
+  return NAN;
+}
+
+// Exact corners: the fit lands on the rendered truth. Tolerances: the committed truth
+// pixels are written with 17 digits, so only the solver's convergence limits the result;
+// 1e-3 mm on m and 1e-2 px on the principal point are far below what a 0.02 px corner noise
+// would allow (the trust tests measure those).
+TEST(CalibrateApi, ExactCornersRecoverTheRenderedSensorAndWarnAsTyped) {
+  CalibrationOptions options;
+  options.max_predicted_error_px = 0.0;  // every predicted map exceeds it: a typed warning each
+  const CalibrationResult result = Calibrate(InputFromTruth(), options);
+  const Sensor truth = LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-sph-misaligned.yaml");
+  std::map<std::string, double> expected;
+  for (const ParameterEstimate& p : SensorParameters(truth)) expected[p.name] = p.value;
+  EXPECT_LT(result.record.rms_px, 1e-3);
+  EXPECT_NEAR(Parameter(result.record, "m_mm"), expected["m_mm"], 1e-3);
+  EXPECT_NEAR(Parameter(result.record, "cx_px"), expected["cx_px"], 1e-2);
+  EXPECT_NEAR(Parameter(result.record, "cy_px"), expected["cy_px"], 1e-2);
+  EXPECT_EQ(result.views.images.size(), 8u);
+  EXPECT_TRUE(result.detections.images.empty());  // given, not detected
+  int high = 0;
+  for (const CalibrationWarning& w : result.warnings) high += w.code == WarningCode::kPredictedErrorHigh;
+  EXPECT_EQ(high, static_cast<int>(result.predicted.size()));
+  EXPECT_EQ(result.predicted.size(), 2u);  // the boards' median distance and infinity
+  EXPECT_EQ(result.record.warnings.size(), result.warnings.size());
+}
+
+TEST(CalibrateApi, RecordRoundTripsThroughCalibrationJson) {
+  CalibrationOptions options;
+  options.leave_one_out = true;
+  options.distances_n = {7.0};
+  const CalibrationResult result = Calibrate(InputFromTruth(), options);
+  const std::string path = (std::filesystem::temp_directory_path() / "omnical_calibrate_api_test.json").string();
+  WriteCalibrationJson(result.record, path);
+  const CalibrationRecord back = ReadCalibrationJson(path);
+  std::filesystem::remove(path);
+  // The text is the same when written again: every field was read back.
+  EXPECT_EQ(CalibrationJsonText(back), CalibrationJsonText(result.record));
+  EXPECT_EQ(back.parameters.size(), result.record.parameters.size());
+  EXPECT_EQ(back.poses.size(), 8u);
+  EXPECT_EQ(back.leave_one_out.size(), result.record.leave_one_out.size());
+  ASSERT_EQ(back.covariance.rows(), result.record.covariance.rows());
+  EXPECT_EQ((back.covariance - result.record.covariance).cwiseAbs().maxCoeff(), 0.0);
+  ASSERT_EQ(back.predicted_error.size(), 1u);
+  EXPECT_EQ(back.predicted_error[0].max_px, result.record.predicted_error[0].max_px);
+}
+
+TEST(CalibrateApi, BadOptionsAndInputsNameTheField) {
+  CalibrationOptions options;
+  options.fixed = {"focal"};
+  try {
+    Calibrate(InputFromTruth(), options);
+    FAIL() << "an unknown block was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("fixed: unknown block 'focal'", 0), 0u) << error.what();
+  }
+  options = {};
+  options.distances_n = {-1.0};
+  EXPECT_EQ(options.Check().rfind("distances_n:", 0), 0u);
+  CalibrationInput none = InputFromTruth();
+  none.detections.reset();
+  EXPECT_THROW(Calibrate(none, CalibrationOptions()), InputError);
+  options = {};
+  options.tolerances = {{"B_mm", 1.0}};  // a sphere has no B
+  try {
+    Calibrate(InputFromTruth(), options);
+    FAIL() << "a tolerance on a missing parameter was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("tolerances: ", 0), 0u) << error.what();
+  }
+}
+
+TEST(CalibrateApi, CallbackReturningFalseCancels) {
+  CalibrationOptions options;
+  std::vector<std::string> stages;
+  options.progress = [&](const ProgressUpdate& update) {
+    stages.push_back(update.stage);
+    return update.stage != "fit" || update.done == 0;  // stop once the first fit is done
+  };
+  EXPECT_THROW(Calibrate(InputFromTruth(), options), Cancelled);
+  ASSERT_FALSE(stages.empty());
+  EXPECT_EQ(stages.back(), "fit");
+}
+
+// Images in memory give the same corners as the same images read from their files (two
+// views keep it short: detection is ~1 s per image).
+TEST(CalibrateApi, DetectsImagesInMemoryAsFromFiles) {
+  const CalibrationTarget target =
+      CalibrationTarget::FromYaml(testing::SourceDir() + "/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml");
+  const std::vector<std::string> paths = {testing::SourceDir() + kSet + "/near000.png", testing::SourceDir() + kSet + "/near001.png"};
+  std::vector<NamedImage> images;
+  for (const std::string& path : paths) images.push_back({path, cv::imread(path, cv::IMREAD_GRAYSCALE)});
+  images.push_back({"blank", cv::Mat()});  // unreadable: skipped with a warning
+  DetectionOptions options;
+  const DetectedImages from_files = DetectImageFiles(target, paths, "two renders", options);
+  const DetectedImages in_memory = DetectImages(target, images, options);
+  ASSERT_EQ(in_memory.detections.images.size(), 2u);
+  ASSERT_EQ(in_memory.warnings.size(), 1u);
+  EXPECT_EQ(in_memory.warnings[0].code, WarningCode::kImageUnreadable);
+  for (size_t i = 0; i < 2; ++i) {
+    const auto& a = from_files.detections.images[i].corners;
+    const auto& b = in_memory.detections.images[i].corners;
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_GT(a.size(), 20u);
+    for (size_t k = 0; k < a.size(); ++k) EXPECT_EQ((a[k].pixel - b[k].pixel).norm(), 0.0);
+  }
+  std::vector<NamedImage> colour = {{"colour", cv::Mat(8, 8, CV_8UC3)}};
+  EXPECT_THROW(DetectImages(target, colour, options), InputError);
+}
+
+}  // namespace
+}  // namespace omnical
