@@ -7,7 +7,18 @@
 #include <mutex>
 #include <string>
 
+#include "model/progress.h"
+#include "tools/cli_common.h"
+
 namespace omnical::cli {
+
+// True once the user asked the running command to stop (Ctrl-C); library jobs are told
+// through their progress callbacks.
+bool InterruptRequested();
+
+// A ProgressCallback for library jobs: the same one-line bar per stage as Progress (only
+// when stderr is a terminal and --quiet was not given); returns !InterruptRequested().
+ProgressCallback TerminalProgress(const Context& context);
 
 class Progress {
  public:
