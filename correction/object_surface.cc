@@ -25,8 +25,8 @@ std::optional<ObjectSurface::Kind> ParseSurfaceKind(const std::string& name) {
 std::string ObjectSurface::Check() const {
   if (kind == Kind::kInfinity) return "";
   if (!(std::isfinite(distance_mm) && distance_mm > 0.0))
-    return "distance-mm: " + std::to_string(distance_mm) + " (must be a finite distance > 0)";
-  if (kind == Kind::kPlane && !(plane_normal.allFinite() && plane_normal.norm() > 1e-12)) return "plane-normal: zero or not finite";
+    return "distance_mm: " + std::to_string(distance_mm) + " (must be a finite distance > 0)";
+  if (kind == Kind::kPlane && !(plane_normal.allFinite() && plane_normal.norm() > 1e-12)) return "plane_normal: zero or not finite";
   return "";
 }
 

@@ -9,7 +9,7 @@
 namespace omnical {
 
 ParallaxMap ComputeParallaxMap(const Sensor& sensor, double object_distance_mm, double v0_mm, int threads,
-                               const std::function<void(long)>& progress) {
+                               const ProgressCallback& progress_callback) {
   ParallaxMap map;
   map.width = sensor.image_width_px();
   map.height = sensor.image_height_px();
@@ -19,7 +19,9 @@ ParallaxMap ComputeParallaxMap(const Sensor& sensor, double object_distance_mm, 
       cache.camera_from_mirror_rotation * Eigen::Vector3d(0.0, 0.0, v0_mm) + cache.camera_from_mirror_translation;
   // "Distant" = far enough that the viewpoint spread (mm) is invisible: 1e7 rim radii.
   const double far_mm = 1e7 * sensor.rim_radius_mm();
+  ProgressReporter progress(progress_callback, "parallax map", map.height);
   ParallelRows(map.height, threads, [&](int v) {
+    if (progress.cancelled()) return;
     Eigen::Matrix2Xd pixels(2, map.width), looked_up;
     Eigen::Matrix3Xd origins, directions, far_points(3, map.width);
     std::vector<ProjectionStatus> ray_status, far_status;
@@ -35,8 +37,9 @@ ParallaxMap ComputeParallaxMap(const Sensor& sensor, double object_distance_mm, 
       if (ray_status[u] != ProjectionStatus::kOk || far_status[u] != ProjectionStatus::kOk) continue;
       map.error_px[static_cast<size_t>(v) * map.width + u] = static_cast<float>((looked_up.col(u) - pixels.col(u)).norm());
     }
-    if (progress) progress(1);
+    progress.Advance();
   });
+  progress.ThrowIfCancelled();
   for (float e : map.error_px)
     if (std::isfinite(e)) map.max_abs_error_px = std::max(map.max_abs_error_px, double(e));
   return map;

@@ -5,9 +5,9 @@
 // that pixel and the true one.
 #pragma once
 
-#include <functional>
 #include <vector>
 
+#include "model/progress.h"
 #include "model/sensor.h"
 
 namespace omnical {
@@ -19,8 +19,9 @@ struct ParallaxMap {
 };
 
 // v0_mm: V0 as z on the mirror axis, mirror frame. Rows are spread over `threads`
-// threads; progress(rows) is called as rows finish (from any thread).
+// threads; reports stage "parallax map", one step per image row, and throws Cancelled
+// when the callback returns false.
 ParallaxMap ComputeParallaxMap(const Sensor& sensor, double object_distance_mm, double v0_mm, int threads,
-                               const std::function<void(long)>& progress = nullptr);
+                               const ProgressCallback& progress = nullptr);
 
 }  // namespace omnical

@@ -100,7 +100,7 @@ int AutomaticStep(const VirtualScreen& screen) {
 // The interpolated path (see remap_table.h). Node (i, j) sits at output point
 // ((i - 1) step, (j - 1) step): one node beyond each side, so that the pixel u in cell
 // a = u / step has the nodes a .. a + 3 around it.
-void FillByInterpolation(const Sensor& sensor, const RemapSettings& settings, const std::function<void(long)>& progress,
+void FillByInterpolation(const Sensor& sensor, const RemapSettings& settings, ProgressReporter& progress,
                          RemapTable* table) {
   const int step = settings.interpolation_step_px > 0 ? settings.interpolation_step_px : AutomaticStep(settings.screen);
   const int width = table->width, height = table->height;
@@ -156,6 +156,7 @@ void FillByInterpolation(const Sensor& sensor, const RemapSettings& settings, co
   std::atomic<long> valid{0}, exact_pixels{0};
   const ImageArea image(sensor);
   ParallelRows(height, settings.threads, [&](int v) {
+    if (progress.cancelled()) return;
     const int b = v / step;
     const std::array<double, 4> w = CubicWeights(double(v % step) / step);
     const size_t row0 = static_cast<size_t>(b) * width;
@@ -182,7 +183,7 @@ void FillByInterpolation(const Sensor& sensor, const RemapSettings& settings, co
       exact_pixels += projected;
     }
     valid += row_valid;
-    if (progress) progress(1);
+    progress.Advance();
   });
   table->valid_pixels = valid;
   table->exact_pixels = exact_pixels;
@@ -192,7 +193,7 @@ void FillByInterpolation(const Sensor& sensor, const RemapSettings& settings, co
 
 }  // namespace
 
-RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, const std::function<void(long)>& progress) {
+RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, const ProgressCallback& progress_callback) {
   const VirtualScreen& screen = settings.screen;
   RemapTable table;
   table.width = screen.width_px;
@@ -206,8 +207,10 @@ RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, 
       screen.type == VirtualScreen::Type::kPanorama || screen.type == VirtualScreen::Type::kLonLat;
   table.used_axial_symmetry =
       settings.allow_shortcuts && sensor.is_axial() && cylindrical_screen && settings.surface.IsAxiallySymmetric();
+  ProgressReporter progress(progress_callback, "remap table", table.height);
   if (settings.allow_shortcuts && !table.used_axial_symmetry) {
     FillByInterpolation(sensor, settings, progress, &table);
+    progress.ThrowIfCancelled();
     return table;
   }
   std::atomic<long> valid{0};
@@ -227,6 +230,7 @@ RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, 
       cos_phi[u] = std::cos(phi), sin_phi[u] = std::sin(phi);
     }
     ParallelRows(table.height, settings.threads, [&](int v) {
+      if (progress.cancelled()) return;
       // The row's direction at azimuth 0, turned to 0, 90, 180, 270 deg.
       Eigen::Vector3d d;
       screen.Direction(0.0, v, &d);
@@ -262,14 +266,16 @@ RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, 
         // goes pixel by pixel. (Any other failure holds at every azimuth.)
         project_row(v);
       }
-      if (progress) progress(1);
+      progress.Advance();
     });
   } else {
     ParallelRows(table.height, settings.threads, [&](int v) {
+      if (progress.cancelled()) return;
       project_row(v);
-      if (progress) progress(1);
+      progress.Advance();
     });
   }
+  progress.ThrowIfCancelled();
   table.valid_pixels = valid;
   return table;
 }

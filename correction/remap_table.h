@@ -18,11 +18,11 @@
 // and pixels spread over threads.
 #pragma once
 
-#include <functional>
 #include <vector>
 
 #include "correction/object_surface.h"
 #include "correction/virtual_screen.h"
+#include "model/progress.h"
 #include "model/sensor.h"
 
 namespace omnical {
@@ -69,8 +69,9 @@ double InfinityDistanceMm(const Sensor& sensor);
 bool RemapObjectPoint(const Sensor& sensor, const RemapSettings& settings, double col, double row,
                       Eigen::Vector3d* point_in_mirror);
 
-// progress(rows) is called as rows finish, from any thread.
+// Reports stage "remap table", one step per output row (from any thread, serialised);
+// throws Cancelled when the callback returns false.
 RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings,
-                           const std::function<void(long)>& progress = nullptr);
+                           const ProgressCallback& progress = nullptr);
 
 }  // namespace omnical

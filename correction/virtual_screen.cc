@@ -52,20 +52,20 @@ std::string VirtualScreen::Check() const {
     case Type::kPanorama:
     case Type::kLonLat: {
       if (!finite(azimuth0_deg) || !finite(elevation_top_deg) || !finite(elevation_bottom_deg))
-        return "elevation/azimuth: not finite";
+        return "azimuth0_deg/elevation_deg: not finite";
       const double limit = type == Type::kPanorama ? 89.0 : 90.0;  // a cylinder cannot reach the poles
       if (!(elevation_top_deg > elevation_bottom_deg) || elevation_top_deg > limit || elevation_bottom_deg < -limit)
-        return "elevation: top " + std::to_string(elevation_top_deg) + " deg must be above bottom " +
+        return "elevation_deg: top " + std::to_string(elevation_top_deg) + " deg must be above bottom " +
                std::to_string(elevation_bottom_deg) + " deg, both within +-" + std::to_string(int(limit)) + " deg";
       return "";
     }
     case Type::kPerspective:
-      if (!finite(pan_deg) || !finite(tilt_deg) || !finite(roll_deg)) return "pan/tilt/roll: not finite";
-      if (!(hfov_deg > 0.0 && hfov_deg < 170.0)) return "hfov: " + std::to_string(hfov_deg) + " deg (0 < hfov < 170)";
-      if (std::abs(tilt_deg) > 90.0) return "tilt: " + std::to_string(tilt_deg) + " deg (within +-90)";
+      if (!finite(pan_deg) || !finite(tilt_deg) || !finite(roll_deg)) return "pan_deg/tilt_deg/roll_deg: not finite";
+      if (!(hfov_deg > 0.0 && hfov_deg < 170.0)) return "hfov_deg: " + std::to_string(hfov_deg) + " deg (0 < hfov < 170)";
+      if (std::abs(tilt_deg) > 90.0) return "tilt_deg: " + std::to_string(tilt_deg) + " deg (within +-90)";
       return "";
     case Type::kEquiangular:
-      if (!(omega_max_deg > 0.0 && omega_max_deg <= 180.0)) return "omega-max: " + std::to_string(omega_max_deg) + " deg (0..180)";
+      if (!(omega_max_deg > 0.0 && omega_max_deg <= 180.0)) return "omega_max_deg: " + std::to_string(omega_max_deg) + " deg (0..180)";
       return "";
   }
   return "type: unknown";

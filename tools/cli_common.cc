@@ -21,12 +21,6 @@ void WriteOutput(const std::string& path, const std::function<void(std::ostream&
 
 cv::Mat ReadImage(const std::string& path, int flags) { return ReadImageFile(path, flags); }
 
-std::string WithFlagNames(const std::string& message, const FlagNames& flags) {
-  for (const auto& [field, flag] : flags)
-    if (message.rfind(field + ": ", 0) == 0) return flag + message.substr(field.size());
-  return message;
-}
-
 void PrintWarnings(const std::vector<CalibrationWarning>& warnings, const Context& context) {
   for (const CalibrationWarning& w : warnings)
     if (!context.quiet || w.code != WarningCode::kViewSkipped) std::fprintf(stderr, "omnical: warning: %s\n", w.text.c_str());

@@ -9,11 +9,10 @@
 #include <functional>
 #include <iosfwd>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "calib/calibration_warning.h"
-#include "model/input_error.h"
+#include "tools/field_flags.h"
 
 namespace omnical::cli {
 
@@ -43,20 +42,6 @@ void WriteOutput(const std::string& path, const std::function<void(std::ostream&
 
 // cv::imread with a check first that a PNG is complete (calib/image_file.h).
 cv::Mat ReadImage(const std::string& path, int flags);
-
-// Library messages begin with the field they concern ("fixed: unknown block ..."); the
-// CLI names its flag instead. Pairs of (field, flag).
-using FlagNames = std::vector<std::pair<std::string, std::string>>;
-std::string WithFlagNames(const std::string& message, const FlagNames& flags);
-// Runs `call`, rewriting the leading field of an InputError it throws.
-template <class Call>
-auto NamingFlags(const FlagNames& flags, Call&& call) -> decltype(call()) {
-  try {
-    return call();
-  } catch (const InputError& error) {
-    throw InputError(WithFlagNames(error.what(), flags));
-  }
-}
 
 // "omnical: warning: text" on stderr for each (those about skipped views only without --quiet).
 void PrintWarnings(const std::vector<CalibrationWarning>& warnings, const Context& context);

@@ -22,7 +22,7 @@ struct Options {
   CalibrationOptions library;
 };
 
-const FlagNames kFlags = {{"fixed", "--fix"}, {"robust_loss_px", "--loss-px"}, {"loss_px", "--loss-px"},
+const FlagTable kFlags = {{"fixed", "--fix"}, {"robust_loss_px", "--loss-px"}, {"loss_px", "--loss-px"},
                           {"max_iterations", "--max-iterations"}, {"tolerances", "--tolerance"}, {"profile", "--profile"},
                           {"rim_field_deg", "--rim-field-deg"}, {"guess", "--sensor"}, {"threads", "--threads"},
                           {"detection_passes", "--detection-passes"}, {"distances_mm", "--distance-mm"},

@@ -19,12 +19,12 @@
 #include "calib/target.h"
 #include "correction/map_export.h"
 #include "calib/synthetic/scene.h"
+#include "correction/maps_json.h"
 #include "model/csv_reader.h"
 #include "model/design_spec_yaml.h"
 #include "model/input_error.h"
 #include "model/sensor.h"
 #include "model/tabulated_profile.h"
-#include "tools/view_setup.h"
 
 namespace {
 
@@ -73,7 +73,7 @@ void RunTarget(const std::string& target, const uint8_t* data, size_t size) {
     ReadDetections(WriteInput(data, size, "detections.json"));
   } else if (target == "maps_json") {
     WriteInput(data, size, "maps.json");
-    cli::ReadMapsDescription((WorkDir() / "in").string(), nullptr);
+    ReadMapsDescription((WorkDir() / "in").string(), nullptr);
   } else if (target == "maps_yml") {
     ReadOpenCvMaps(WriteInput(data, size, "maps.yml"));
   } else if (target == "points_csv") {

@@ -1,0 +1,103 @@
+#include "correction/unwarp.h"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <utility>
+#include <vector>
+
+#include "correction/maps_json.h"
+#include "model/atomic_write.h"
+#include "model/input_error.h"
+
+namespace omnical {
+
+std::optional<Interpolation> ParseInterpolation(const std::string& name) {
+  if (name == "nearest") return Interpolation::kNearest;
+  if (name == "linear") return Interpolation::kLinear;
+  if (name == "cubic") return Interpolation::kCubic;
+  return std::nullopt;
+}
+
+Unwarper::Unwarper(RemapTable table, int input_width_px, int input_height_px, Interpolation interpolation)
+    : input_width_px_(input_width_px), input_height_px_(input_height_px), interpolation_(interpolation) {
+  map_x_ = cv::Mat(table.height, table.width, CV_32F, table.map_x.data()).clone();
+  map_y_ = cv::Mat(table.height, table.width, CV_32F, table.map_y.data()).clone();
+  cv::convertMaps(map_x_, map_y_, map1_, map2_, CV_16SC2);
+}
+
+Unwarper Unwarper::FromMaps(const std::string& dir, Interpolation interpolation, const Sensor* sensor,
+                            const std::string& sensor_name) {
+  RemapTable table;
+  const MapsDescription maps = ReadMapsDescription(dir, &table);
+  if (maps.sensor_width_px <= 0 || maps.sensor_height_px <= 0)
+    throw InputError(InputMessage(maps.path, "sensor.image_size_px", "missing"));
+  if (sensor != nullptr && (sensor->image_width_px() != maps.sensor_width_px || sensor->image_height_px() != maps.sensor_height_px))
+    throw InputError(InputMessage(sensor_name, "image_size", "differs from the maps' sensor (" + maps.path + ")"));
+  return Unwarper(std::move(table), maps.sensor_width_px, maps.sensor_height_px, interpolation);
+}
+
+Unwarper Unwarper::FromView(const Sensor& sensor, const ViewRequest& view, Interpolation interpolation,
+                            const ProgressCallback& progress) {
+  return Unwarper(BuildRemapTable(sensor, ResolveView(sensor, view).settings, progress), sensor.image_width_px(),
+                  sensor.image_height_px(), interpolation);
+}
+
+cv::Mat Unwarper::Apply(const cv::Mat& frame, const std::string& source) const {
+  if (frame.cols != input_width_px_ || frame.rows != input_height_px_)
+    throw InputError(InputMessage(source, "", "is " + std::to_string(frame.cols) + " x " + std::to_string(frame.rows) +
+                                                  " px but the sensor's image is " + std::to_string(input_width_px_) + " x " +
+                                                  std::to_string(input_height_px_) + " px"));
+  cv::Mat out;
+  if (interpolation_ == Interpolation::kNearest)
+    cv::remap(frame, out, map_x_, map_y_, cv::INTER_NEAREST, cv::BORDER_CONSTANT);
+  else
+    cv::remap(frame, out, map1_, map2_, interpolation_ == Interpolation::kCubic ? cv::INTER_CUBIC : cv::INTER_LINEAR,
+              cv::BORDER_CONSTANT);
+  return out;
+}
+
+long UnwarpFrames(const Unwarper& unwarper, const std::function<bool(cv::Mat*)>& read,
+                  const std::function<void(const cv::Mat&)>& write, long total_frames, const std::string& source,
+                  const ProgressCallback& progress) {
+  ProgressReporter reporter(progress, "unwarp", total_frames);
+  long frames = 0;
+  cv::Mat frame;
+  while (read(&frame)) {
+    write(unwarper.Apply(frame, source));
+    ++frames;
+    reporter.Step();
+  }
+  if (frames == 0) throw InputError(InputMessage(source, "", "has no readable frames"));
+  return frames;
+}
+
+std::string LowerExtension(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+  return extension;
+}
+
+bool IsVideoPath(const std::string& path) {
+  const std::string extension = LowerExtension(path);
+  for (const char* video : {".mp4", ".avi", ".mkv", ".mov", ".webm", ".mpg", ".mpeg", ".m4v"})
+    if (extension == video) return true;
+  return false;
+}
+
+void WriteImageFile(const std::string& path, const cv::Mat& image) {
+  std::vector<uchar> bytes;
+  const std::string extension = LowerExtension(path);
+  bool encoded = false;
+  try {
+    encoded = cv::imencode(extension.empty() ? ".png" : extension, image, bytes);
+  } catch (const cv::Exception&) {
+  }
+  if (!encoded) throw InputError(InputMessage(path, "", "cannot encode an image of this type (use .png, .jpg, .tif)"));
+  WriteFileAtomically(path, [&](std::ostream& out) { out.write(reinterpret_cast<const char*>(bytes.data()), bytes.size()); });
+}
+
+}  // namespace omnical
