@@ -14,6 +14,7 @@
 #include "calib/calibration_json.h"
 #include "calib/image_file.h"
 #include "calib/synthetic/ground_truth.h"
+#include "model/input_error.h"
 #include "test_sensors.h"
 
 namespace omnical {
