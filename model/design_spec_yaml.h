@@ -13,7 +13,7 @@
 
 #include <string>
 
-#include "model/mirror_design_ode.h"
+#include "model/design/mirror_design_ode.h"
 
 namespace omnical {
 

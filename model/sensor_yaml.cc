@@ -10,6 +10,7 @@
 
 #include "model/atomic_write.h"
 #include "model/input_error.h"
+#include "model/profile_table.h"
 #include "model/sensor.h"
 #include "model/yaml_field_reader.h"
 

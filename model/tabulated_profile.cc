@@ -4,8 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "model/csv_reader.h"
-#include "model/input_error.h"
 
 namespace omnical {
 
@@ -70,24 +68,6 @@ int ProfileSpline::Segment(double knot_variable) const {
   const auto it = std::upper_bound(knots_.begin(), knots_.end(), knot_variable);
   const int index = static_cast<int>(it - knots_.begin()) - 1;
   return std::clamp(index, 0, static_cast<int>(knots_.size()) - 2);
-}
-
-std::shared_ptr<const ProfileSpline> LoadProfileTable(const std::string& path) {
-  const CsvTable table = ReadNumericCsv(path, 2);
-  std::vector<double> radius, sag;
-  bool slopes = true;
-  for (const auto& row : table.rows) {
-    radius.push_back(row[0]);
-    sag.push_back(row[1]);
-    slopes = slopes && row.size() >= 3;
-  }
-  try {
-    const double end_slope = slopes ? table.rows.back()[2] : NAN;
-    const double vertex_slope = slopes ? table.rows.front()[2] : 0.0;
-    return std::make_shared<const ProfileSpline>(std::move(radius), std::move(sag), end_slope, vertex_slope);
-  } catch (const std::invalid_argument& error) {
-    throw InputError(InputMessage(path, "", error.what()));
-  }
 }
 
 }  // namespace omnical

@@ -1,4 +1,5 @@
-// A mirror profile given as samples (r_i, z_i), e.g. a designed mirror loaded from CSV.
+// A mirror profile given as samples (r_i, z_i), e.g. a designed mirror loaded from CSV (the
+// file format: model/profile_table.h).
 //
 // Interpolated by a cubic spline in s = r^2: C2, so the curvatures the optics analysis
 // needs (f'') are continuous, and smooth across the axis by construction. Natural at the
@@ -108,10 +109,5 @@ struct TabulatedProfile {
     return {spline, source};
   }
 };
-
-// Loads "r,z[,dz/dr,...]" rows (mm); a dz/dr column on every row clamps the end slope, and
-// a non-zero one on the vertex row makes the vertex a cone point.
-// Throws InputError naming the file, the line and the problem.
-std::shared_ptr<const ProfileSpline> LoadProfileTable(const std::string& path);
 
 }  // namespace omnical

@@ -4,9 +4,9 @@
 
 #include <cmath>
 
-#include "model/designed_sensor.h"
+#include "model/design/designed_sensor.h"
+#include "model/design/mirror_design_ode.h"
 #include "model/input_error.h"
-#include "model/mirror_design_ode.h"
 #include "test_sensors.h"
 
 namespace omnical {

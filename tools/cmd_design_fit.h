@@ -1,21 +1,19 @@
-// `omnical design fit`: the options and the run, registered by cmd_design.cc beside `ode`.
+// `omnical design fit`: the flags and the run, registered by cmd_design.cc beside `ode`.
 #pragma once
 
 #include <string>
 
+#include "model/design/design_fit_job.h"
 #include "tools/cli_common.h"
 
 namespace omnical::cli {
 
-struct DesignFitOptions {
+struct DesignFitFlags {
   std::string profile, characteristic, compare_path, out_dir;
-  int terms = 3;
-  double rim_omega_deg = 135.0, rim_theta_deg = 12.0;
-  double rim_radius_mm = 43.9;  // the shipped Table 1 sensors' rim
-  int image_size_px = 1000;
+  DesignFitOptions job;
 };
 
-void AddDesignFitOptions(CLI::App* fit, DesignFitOptions* options);
-void RunDesignFit(const DesignFitOptions& options, const Context& context);
+void AddDesignFitOptions(CLI::App* fit, DesignFitFlags* flags);
+void RunDesignFit(DesignFitFlags& flags, const Context& context);
 
 }  // namespace omnical::cli

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <iomanip>
 
 #include "model/atomic_write.h"
 #include "model/input_error.h"
@@ -48,23 +47,25 @@ struct Layout {
 };
 
 // The sample interval [i, i + 1] holding radius r.
-size_t IntervalOf(const ProfileDrawing& d, double r) {
-  const auto upper = std::upper_bound(d.radius_mm.begin(), d.radius_mm.end(), r);
-  return std::clamp<size_t>(upper - d.radius_mm.begin(), 1, d.radius_mm.size() - 1) - 1;
+size_t IntervalOf(const ProfileTable& p, double r) {
+  const auto upper = std::upper_bound(p.radius_mm.begin(), p.radius_mm.end(), r);
+  return std::clamp<size_t>(upper - p.radius_mm.begin(), 1, p.radius_mm.size() - 1) - 1;
 }
 
 // Cubic Hermite through the samples (value and slope), so stations between samples keep
 // the design's accuracy.
 double SagAt(const ProfileDrawing& d, double r) {
-  const size_t i = IntervalOf(d, r);
-  const double h = d.radius_mm[i + 1] - d.radius_mm[i], t = (r - d.radius_mm[i]) / h;
+  const ProfileTable& p = d.profile;
+  const size_t i = IntervalOf(p, r);
+  const double h = p.radius_mm[i + 1] - p.radius_mm[i], t = (r - p.radius_mm[i]) / h;
   const double h00 = (1 + 2 * t) * (1 - t) * (1 - t), h10 = t * (1 - t) * (1 - t), h01 = t * t * (3 - 2 * t), h11 = t * t * (t - 1);
-  return h00 * d.sag_mm[i] + h10 * h * d.slope[i] + h01 * d.sag_mm[i + 1] + h11 * h * d.slope[i + 1];
+  return h00 * p.sag_mm[i] + h10 * h * p.slope[i] + h01 * p.sag_mm[i + 1] + h11 * h * p.slope[i + 1];
 }
 double SlopeAt(const ProfileDrawing& d, double r) {
-  const size_t i = IntervalOf(d, r);
-  const double t = (r - d.radius_mm[i]) / (d.radius_mm[i + 1] - d.radius_mm[i]);
-  return (1 - t) * d.slope[i] + t * d.slope[i + 1];
+  const ProfileTable& p = d.profile;
+  const size_t i = IntervalOf(p, r);
+  const double t = (r - p.radius_mm[i]) / (p.radius_mm[i + 1] - p.radius_mm[i]);
+  return (1 - t) * p.slope[i] + t * p.slope[i + 1];
 }
 
 std::string Fixed(double value, int digits) {
@@ -75,7 +76,7 @@ std::string Fixed(double value, int digits) {
 
 Layout MakeLayout(const ProfileDrawing& d) {
   Layout layout;
-  const double rim = d.radius_mm.back(), rim_sag = d.sag_mm.back();
+  const double rim = d.profile.radius_mm.back(), rim_sag = d.profile.sag_mm.back();
   // The section to scale in the left 1000 x 1000 px, vertex low, the lens side below.
   const double scale = std::min(600.0 / (2.0 * rim), 540.0 / std::max(rim_sag, 1e-9));
   const cv::Point2d vertex(430.0, 740.0);
@@ -84,8 +85,8 @@ Layout MakeLayout(const ProfileDrawing& d) {
   layout.Text({800.0, 40.0}, d.title, 26.0, true);
   Stroke surface;
   surface.width = 3.0;
-  for (size_t i = d.radius_mm.size(); i-- > 0;) surface.points.push_back(at(-d.radius_mm[i], d.sag_mm[i]));
-  for (size_t i = 1; i < d.radius_mm.size(); ++i) surface.points.push_back(at(d.radius_mm[i], d.sag_mm[i]));
+  for (size_t i = d.profile.radius_mm.size(); i-- > 0;) surface.points.push_back(at(-d.profile.radius_mm[i], d.profile.sag_mm[i]));
+  for (size_t i = 1; i < d.profile.radius_mm.size(); ++i) surface.points.push_back(at(d.profile.radius_mm[i], d.profile.sag_mm[i]));
   layout.strokes.push_back(surface);
   layout.Line(at(-rim, rim_sag), at(rim, rim_sag), 1.0, true);  // the rim plane
   // The axis between the vertex note and the diameter's dimension line.
@@ -120,8 +121,8 @@ Layout MakeLayout(const ProfileDrawing& d) {
   const double row = std::min(34.0, 600.0 / stations);
   for (int i = 0; i <= stations; ++i) {
     const double r = rim * i / stations;
-    const double z = i == 0 ? d.sag_mm.front() : i == stations ? rim_sag : SagAt(d, r);
-    const double slope = i == 0 ? d.slope.front() : i == stations ? d.slope.back() : SlopeAt(d, r);
+    const double z = i == 0 ? d.profile.sag_mm.front() : i == stations ? rim_sag : SagAt(d, r);
+    const double slope = i == 0 ? d.profile.slope.front() : i == stations ? d.profile.slope.back() : SlopeAt(d, r);
     y += row;
     const std::string cells[] = {Fixed(r, 3), Fixed(z, 3), Fixed(slope, 5), Fixed(std::atan(slope) * 180.0 / M_PI, 3)};
     for (int c = 0; c < 4; ++c) layout.Text({left + columns[c], y}, cells[c], 17.0);
@@ -130,8 +131,8 @@ Layout MakeLayout(const ProfileDrawing& d) {
   std::vector<std::string> notes = {"All dimensions in mm. Surface of revolution about the axis;",
                                     "z measured from the vertex, away from the lens."};
   // The reflection ODE can give the axis a cone point; a workshop must know.
-  if (std::abs(d.slope.front()) > 1e-6)
-    notes.push_back("The vertex is a cone point: slope " + Fixed(std::atan(d.slope.front()) * 180.0 / M_PI, 3) + " deg at x = 0.");
+  if (std::abs(d.profile.slope.front()) > 1e-6)
+    notes.push_back("The vertex is a cone point: slope " + Fixed(std::atan(d.profile.slope.front()) * 180.0 / M_PI, 3) + " deg at x = 0.");
   notes.insert(notes.end(), d.notes.begin(), d.notes.end());
   for (const std::string& note : notes) {
     layout.Text({left - 10.0, y}, note, 15.0);
@@ -196,16 +197,6 @@ cv::Mat RenderPng(const Layout& layout) {
 }
 
 }  // namespace
-
-void WriteProfileTable(const ProfileDrawing& drawing, const std::string& source, const std::string& path) {
-  WriteFileAtomically(path, [&](std::ostream& out) {
-    out << "# mirror profile from omnical " << source << ": radius x, sag z from the vertex, slope dz/dx (mm)\n"
-        << "x_mm,z_mm,dz_dx\n"
-        << std::setprecision(15);
-    for (size_t i = 0; i < drawing.radius_mm.size(); ++i)
-      out << drawing.radius_mm[i] << ',' << drawing.sag_mm[i] << ',' << drawing.slope[i] << '\n';
-  });
-}
 
 void WriteProfileDrawing(const ProfileDrawing& drawing, const std::string& svg_path, const std::string& png_path) {
   const Layout layout = MakeLayout(drawing);

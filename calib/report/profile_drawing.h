@@ -7,20 +7,16 @@
 #include <string>
 #include <vector>
 
+#include "model/profile_table.h"
+
 namespace omnical {
 
 struct ProfileDrawing {
   std::string title;               // e.g. "omnical design fit: polynomial, equidistant"
-  std::vector<double> radius_mm;   // strictly increasing from 0 (the vertex) to the rim
-  std::vector<double> sag_mm;      // z from the vertex, away from the lens
-  std::vector<double> slope;       // dz/dr
+  ProfileTable profile;            // from the vertex to the rim (model/profile_table.h)
   std::vector<std::string> notes;  // lines printed under the table (lens distance, source)
   int stations = 16;               // ordinate rows, evenly spaced in radius, rim included
 };
-
-// The profile table a tabulated mirror reads (x_mm, z_mm, dz_dx; see README "Sensor
-// file"), from the drawing's samples; `source` names the subcommand in its comment line.
-void WriteProfileTable(const ProfileDrawing& drawing, const std::string& source, const std::string& path);
 
 // Throws InputError naming the path when a file cannot be written.
 void WriteProfileDrawing(const ProfileDrawing& drawing, const std::string& svg_path, const std::string& png_path);

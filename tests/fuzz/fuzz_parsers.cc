@@ -23,6 +23,7 @@
 #include "model/csv_reader.h"
 #include "model/design_spec_yaml.h"
 #include "model/input_error.h"
+#include "model/profile_table.h"
 #include "model/sensor.h"
 #include "model/tabulated_profile.h"
 

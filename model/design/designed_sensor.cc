@@ -1,4 +1,4 @@
-#include "model/designed_sensor.h"
+#include "model/design/designed_sensor.h"
 
 #include <cmath>
 #include <memory>

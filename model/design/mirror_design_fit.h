@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "model/progress.h"
 #include "model/sensor.h"
 
 namespace omnical {
@@ -57,8 +58,9 @@ struct FitDesign {
 
 // Throws InputError naming the cause when the targets are outside the family's reach,
 // Ceres does not converge, or the fitted mirror folds the image (Omega or the image
-// height stops increasing with x, "at x = ... (mirror radii)").
-FitDesign FitMirrorDesign(const FitDesignSpec& spec);
+// height stops increasing with x, "at x = ... (mirror radii)"). `progress` hears of each
+// Ceres iteration (stage "fit"); returning false stops the solve and throws Cancelled.
+FitDesign FitMirrorDesign(const FitDesignSpec& spec, const ProgressCallback& progress = {});
 
 // The design as an axial sensor: mirror radius rim_radius_mm, a pinhole with the rim at
 // image_size_px / 2 from the centre (the paper's 2N = image size).

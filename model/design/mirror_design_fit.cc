@@ -1,4 +1,4 @@
-#include "model/mirror_design_fit.h"
+#include "model/design/mirror_design_fit.h"
 
 #include <ceres/ceres.h>
 
@@ -126,6 +126,19 @@ struct CharacteristicResiduals {
   }
 };
 
+// Ceres' iteration callback forwarding to a ProgressReporter: a false from the caller
+// aborts the solve.
+class IterationProgress : public ceres::IterationCallback {
+ public:
+  explicit IterationProgress(ProgressReporter* reporter) : reporter_(reporter) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    return reporter_->Advance() ? ceres::SOLVER_CONTINUE : ceres::SOLVER_ABORT;
+  }
+
+ private:
+  ProgressReporter* reporter_;
+};
+
 // The image must be one-to-one: Omega and the image height grow with x, the lens below
 // the mirror.
 void CheckPhysical(const FitDesignSpec& spec, const FitDesign& design) {
@@ -176,11 +189,11 @@ const char* CharacteristicName(ImageCharacteristic characteristic) {
 
 std::string FitDesignSpec::Check() const {
   if (!std::isfinite(rim_theta_deg) || !(rim_theta_deg > 0.0 && rim_theta_deg < 90.0))
-    return "rim-theta: must be in (0, 90) deg (the lens's half field at the rim)";
+    return "rim_theta_deg: must be in (0, 90) deg (the lens's half field at the rim)";
   if (!std::isfinite(rim_omega_deg) || !(rim_omega_deg > rim_theta_deg && rim_omega_deg < 180.0))
-    return "rim-omega: must lie between rim-theta and 180 deg (Omega = 2 beta + Theta with a slope 0 < beta < 90 deg)";
+    return "rim_omega_deg: must lie between rim_theta_deg and 180 deg (Omega = 2 beta + Theta with a slope 0 < beta < 90 deg)";
   if (family == ProfileFamily::kPolynomial && (polynomial_terms < 1 || polynomial_terms > 8))
-    return "terms: a polynomial has 1 to 8 even terms";
+    return "polynomial_terms: a polynomial has 1 to 8 even terms";
   if (samples < 10 || samples > 100000) return "samples: must be in [10, 100000]";
   const int free = FreeParams(*this);
   if (free == 0 && characteristic != ImageCharacteristic::kNone)
@@ -194,7 +207,7 @@ std::string FitDesignSpec::Check() const {
   return {};
 }
 
-FitDesign FitMirrorDesign(const FitDesignSpec& spec) {
+FitDesign FitMirrorDesign(const FitDesignSpec& spec, const ProgressCallback& progress) {
   if (const std::string why = spec.Check(); !why.empty()) throw InputError("design fit: " + why);
   const RimTargets rim(spec);
   FitDesign design;
@@ -217,8 +230,13 @@ FitDesign FitMirrorDesign(const FitDesignSpec& spec) {
     options.function_tolerance = 1e-16;
     options.gradient_tolerance = 1e-16;
     options.parameter_tolerance = 1e-14;
+    ProgressReporter reporter(progress, "fit", options.max_num_iterations);
+    reporter.ThrowIfCancelled();
+    IterationProgress iteration_progress(&reporter);
+    options.callbacks.push_back(&iteration_progress);
     ceres::Solver::Summary summary;
     ceres::Solve(options, &problem, &summary);
+    reporter.ThrowIfCancelled();
     design.iterations = static_cast<int>(summary.iterations.size()) - 1;
     design.final_cost = summary.final_cost;
     design.solver_report = summary.BriefReport();

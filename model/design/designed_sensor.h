@@ -1,4 +1,4 @@
-// A mirror designed by the reflection ODE (model/mirror_design_ode.h) as a sensor every
+// A mirror designed by the reflection ODE (model/design/mirror_design_ode.h) as a sensor every
 // other subcommand takes: the profile becomes a tabulated mirror, the design's pinhole the
 // lens, and the imager a square image whose centre the axis meets. Also the check of the
 // design through that sensor: its rays, traced by omnical's own reflection code (not by
@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "model/mirror_design_ode.h"
+#include "model/design/mirror_design_ode.h"
 #include "model/sensor.h"
 
 namespace omnical {

@@ -1,4 +1,4 @@
-#include "model/mirror_design_ode.h"
+#include "model/design/mirror_design_ode.h"
 
 #include <boost/numeric/odeint.hpp>
 

@@ -1,0 +1,90 @@
+#include "model/design/design_fit_job.h"
+
+#include <cmath>
+
+#include "model/input_error.h"
+#include "model/ray_quantities.h"
+
+namespace omnical {
+
+std::string DesignFitOptions::Check() const {
+  if (const std::string why = spec.Check(); !why.empty()) return why;
+  if (!std::isfinite(rim_radius_mm) || !(rim_radius_mm > 0.0)) return "rim_radius_mm: must be > 0";
+  if (image_size_px < 64 || image_size_px > 20000) return "image_size_px: must be in [64, 20000]";
+  if (characteristic_samples < 2) return "characteristic_samples: must be >= 2";
+  if (profile_samples < 4) return "profile_samples: must be >= 4";
+  return {};
+}
+
+ImageCharacteristic DefaultCharacteristic(ProfileFamily family, int polynomial_terms) {
+  if (family == ProfileFamily::kPolynomial && polynomial_terms > 1) return ImageCharacteristic::kEquidistant;
+  if (family == ProfileFamily::kHyperboloid) return ImageCharacteristic::kSingleViewpoint;
+  return ImageCharacteristic::kNone;
+}
+
+std::vector<std::pair<std::string, double>> NormalisedParameters(const FitDesign& design) {
+  std::vector<std::pair<std::string, double>> parameters;
+  if (design.family == ProfileFamily::kPolynomial) {
+    for (size_t k = 0; k < design.params.size(); ++k)
+      parameters.emplace_back("c" + std::to_string(k + 1), design.params[k]);
+  } else {
+    parameters.emplace_back("A", design.params[0]);
+    if (design.family == ProfileFamily::kHyperboloid) parameters.emplace_back("B", design.params[1]);
+  }
+  parameters.emplace_back("m", design.m);
+  return parameters;
+}
+
+DesignFitResult DesignMirrorFit(const DesignFitOptions& options) {
+  if (const std::string why = options.Check(); !why.empty()) throw InputError("design fit: " + why);
+  // The compared sensor first, so a bad one costs no fitting.
+  std::optional<CharacteristicReport> compared;
+  if (options.compare) {
+    ProgressReporter measuring(options.progress, "measure compared", 1);
+    measuring.ThrowIfCancelled();
+    try {
+      compared = MeasureCharacteristics(*options.compare, options.characteristic_samples);
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      const std::string& source = options.compare_source.empty() ? "compare" : options.compare_source;
+      throw InputError(what.rfind(source, 0) == 0 ? what : source + ": " + what);
+    }
+    measuring.Step();
+  }
+
+  const FitDesign design = FitMirrorDesign(options.spec, options.progress);
+  ProgressReporter measuring(options.progress, "measure", 1);
+  measuring.ThrowIfCancelled();
+  const Sensor sensor = SensorFromFitDesign(design, options.spec, options.rim_radius_mm, options.image_size_px);
+  CharacteristicReport achieved = MeasureCharacteristics(sensor, options.characteristic_samples);
+
+  // The profile in mm through the sensor's own model.
+  ProfileTable profile;
+  std::visit(
+      [&](const auto& model) {
+        for (int i = 0; i <= options.profile_samples; ++i) {
+          const AxialRayQuantities q = ComputeAxialRay(model, options.rim_radius_mm * i / options.profile_samples);
+          profile.radius_mm.push_back(q.x_mm);
+          profile.sag_mm.push_back(q.z_mm);
+          profile.slope.push_back(std::tan(q.beta_rad));
+        }
+      },
+      sensor.model());
+  measuring.Step();
+
+  const ImageCharacteristic c = options.spec.characteristic;
+  const ImageCharacteristic law = c == ImageCharacteristic::kNone || c == ImageCharacteristic::kSingleViewpoint
+                                      ? ImageCharacteristic::kEquidistant
+                                      : c;
+  return {options.spec,
+          design,
+          options.rim_radius_mm,
+          sensor,
+          std::move(profile),
+          std::move(achieved),
+          std::move(compared),
+          options.compare ? options.compare_source : std::string(),
+          law};
+}
+
+}  // namespace omnical
