@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "calib/predicted_error.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
 
 namespace omnical {

@@ -5,7 +5,7 @@
 
 #include "calib/bundle_fit.h"
 #include "model/input_error.h"
-#include "model/yaml_field_reader.h"
+#include "model/io/yaml_field_reader.h"
 
 namespace omnical {
 

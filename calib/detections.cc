@@ -7,9 +7,9 @@
 #include <fstream>
 #include <set>
 
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
-#include "model/json_file.h"
+#include "model/io/json_file.h"
 
 namespace omnical {
 

@@ -13,9 +13,9 @@
 #include <filesystem>
 #include <sstream>
 
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
-#include "model/yaml_field_reader.h"
+#include "model/io/yaml_field_reader.h"
 
 namespace omnical {
 namespace {

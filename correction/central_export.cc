@@ -9,7 +9,7 @@
 #include <iomanip>
 
 #include "correction/view_request.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
 #include "model/optics.h"
 

@@ -8,7 +8,7 @@
 #include <cstring>
 #include <functional>
 
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
 
 namespace omnical {

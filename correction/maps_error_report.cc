@@ -8,7 +8,8 @@
 #include <iomanip>
 #include <thread>
 
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 

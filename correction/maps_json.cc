@@ -7,7 +7,7 @@
 #include <fstream>
 
 #include "correction/map_export.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
 
 namespace omnical {

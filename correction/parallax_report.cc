@@ -8,7 +8,7 @@
 #include <iomanip>
 #include <thread>
 
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
 #include "model/optics.h"
 

@@ -4,7 +4,7 @@
 #include <filesystem>
 
 #include "correction/map_export.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 
 namespace omnical {
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "correction/maps_json.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
 
 namespace omnical {

@@ -53,15 +53,6 @@ class Sensor {
   ProjectionCache cache_;
 };
 
-// Sensor file (YAML, see README "Sensor file"). Throws InputError "file: field: problem".
-Sensor LoadSensorYaml(const std::string& path);
-// The same from YAML text (a sensor inline in another file); `source` names it in
-// messages and relative table paths resolve against its directory.
-Sensor ParseSensorYaml(const std::string& yaml_text, const std::string& source);
-// Writes the same format (atomically). Throws InputError if the file cannot be written.
-void SaveSensorYaml(const Sensor& sensor, const std::string& path);
-// The text SaveSensorYaml writes.
-std::string SensorYamlText(const Sensor& sensor);
 // Checks a model the way the reader does; returns "field: problem" or empty.
 std::string ValidateSensorModel(const SensorModel& model);
 

@@ -1,5 +1,5 @@
 // A mirror profile given as samples (r_i, z_i), e.g. a designed mirror loaded from CSV (the
-// file format: model/profile_table.h).
+// file format: model/io/profile_table.h).
 //
 // Interpolated by a cubic spline in s = r^2: C2, so the curvatures the optics analysis
 // needs (f'') are continuous, and smooth across the axis by construction. Natural at the

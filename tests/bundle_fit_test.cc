@@ -10,6 +10,7 @@
 #include "calib/bundle_fit.h"
 #include "calib/synthetic/renderer.h"
 #include "test_sensors.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

@@ -16,6 +16,7 @@
 #include "calib/synthetic/ground_truth.h"
 #include "model/input_error.h"
 #include "test_sensors.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

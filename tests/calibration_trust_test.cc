@@ -16,6 +16,7 @@
 #include "calib/predicted_error.h"
 #include "calib/synthetic/renderer.h"
 #include "test_sensors.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

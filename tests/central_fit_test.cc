@@ -18,6 +18,7 @@
 
 #include "correction/central_fit.h"
 #include "model/sensor.h"
+#include "model/io/sensor_yaml.h"
 #include <sys/wait.h>
 #include <unistd.h>
 

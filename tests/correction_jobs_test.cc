@@ -14,6 +14,7 @@
 #include "correction/unwarp.h"
 #include "model/input_error.h"
 #include "test_sensors.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

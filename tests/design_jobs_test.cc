@@ -9,10 +9,11 @@
 #include "model/design/characterize.h"
 #include "model/design/design_fit_job.h"
 #include "model/design/design_ode_job.h"
-#include "model/design_spec_yaml.h"
+#include "model/design/design_spec_yaml.h"
 #include "model/input_error.h"
 #include "model/progress.h"
 #include "model/sensor.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

@@ -19,6 +19,7 @@
 #include "calib/refine_corners.h"
 #include "calib/synthetic/renderer.h"
 #include "test_sensors.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

@@ -8,6 +8,7 @@
 #include "calib/initial_sensor.h"
 #include "model/input_error.h"
 #include "test_sensors.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

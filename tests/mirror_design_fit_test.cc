@@ -9,6 +9,7 @@
 #include "model/design/mirror_design_fit.h"
 #include "model/input_error.h"
 #include "test_sensors.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

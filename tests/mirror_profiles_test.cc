@@ -7,7 +7,7 @@
 
 #include "model/input_error.h"
 #include "model/mirror_profiles.h"
-#include "model/profile_table.h"
+#include "model/io/profile_table.h"
 #include "model/tabulated_profile.h"
 #include "test_sensors.h"
 

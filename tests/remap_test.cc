@@ -15,6 +15,7 @@
 #include "model/input_error.h"
 #include "model/optics.h"
 #include "test_sensors.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

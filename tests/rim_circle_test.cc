@@ -11,6 +11,7 @@
 
 #include "calib/rim_circle.h"
 #include "test_sensors.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

@@ -8,6 +8,7 @@
 #include "model/ray_quantities.h"
 #include "model/sensor.h"
 #include "test_sensors.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

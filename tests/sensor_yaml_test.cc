@@ -10,6 +10,7 @@
 #include "model/input_error.h"
 #include "model/sensor.h"
 #include "test_sensors.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

@@ -22,6 +22,7 @@
 #include "correction/viewpoint_error.h"
 #include "model/optics.h"
 #include "test_sensors.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

@@ -6,6 +6,7 @@
 #include "correction/parallax_map.h"
 #include "correction/viewpoint_error.h"
 #include "test_sensors.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

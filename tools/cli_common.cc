@@ -6,7 +6,7 @@
 #include <iostream>
 
 #include "calib/image_file.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 
 namespace omnical::cli {
 

@@ -10,9 +10,10 @@
 #include "calib/calibration_json.h"
 #include "calib/image_file.h"
 #include "calib/report/calibration_report.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "tools/commands.h"
 #include "tools/progress.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical::cli {
 namespace {

@@ -6,12 +6,13 @@
 #include <filesystem>
 
 #include "calib/report/optics_figures.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/design/characterize.h"
 #include "model/design/design_files.h"
 #include "model/input_error.h"
 #include "tools/commands.h"
 #include "tools/field_flags.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical::cli {
 namespace {

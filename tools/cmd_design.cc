@@ -6,10 +6,10 @@
 #include <filesystem>
 
 #include "calib/report/design_figures.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/design/design_files.h"
 #include "model/design/design_ode_job.h"
-#include "model/design_spec_yaml.h"
+#include "model/design/design_spec_yaml.h"
 #include "model/input_error.h"
 #include "tools/cmd_design_fit.h"
 #include "tools/commands.h"

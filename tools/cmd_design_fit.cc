@@ -9,10 +9,11 @@
 #include <filesystem>
 
 #include "calib/report/design_figures.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/design/design_files.h"
 #include "model/input_error.h"
 #include "tools/field_flags.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical::cli {
 

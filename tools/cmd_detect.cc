@@ -9,6 +9,7 @@
 #include "calib/image_file.h"
 #include "tools/commands.h"
 #include "tools/progress.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical::cli {
 

@@ -10,6 +10,7 @@
 #include "tools/commands.h"
 #include "tools/field_flags.h"
 #include "tools/progress.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical::cli {
 namespace {

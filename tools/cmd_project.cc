@@ -2,9 +2,10 @@
 #include <iomanip>
 #include <ostream>
 
-#include "model/csv_reader.h"
+#include "model/io/csv_reader.h"
 #include "model/sensor.h"
 #include "tools/commands.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical::cli {
 

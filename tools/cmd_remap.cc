@@ -13,6 +13,7 @@
 #include "tools/commands.h"
 #include "tools/progress.h"
 #include "tools/view_options.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical::cli {
 namespace {

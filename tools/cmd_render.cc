@@ -5,7 +5,7 @@
 #include <thread>
 
 #include "calib/synthetic/render_scene.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "tools/commands.h"
 #include "tools/progress.h"
 

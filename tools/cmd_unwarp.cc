@@ -9,11 +9,12 @@
 #include <filesystem>
 
 #include "correction/unwarp.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
 #include "tools/commands.h"
 #include "tools/progress.h"
 #include "tools/view_options.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical::cli {
 namespace {

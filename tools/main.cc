@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
 #include "tools/commands.h"
 #include "tools/progress.h"

@@ -9,7 +9,7 @@
 #include <mutex>
 #include <string>
 
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 
 namespace omnical::cli {
 namespace {
@@ -18,7 +18,7 @@ volatile std::sig_atomic_t interrupted = 0;
 
 // First Ctrl-C: ask the job to stop at its next progress report (it unwinds, removing
 // the temporary files it was writing). A second one, or a job that does not report:
-// end now the way the signal would (model/atomic_write.h removes temporaries).
+// end now the way the signal would (model/io/atomic_write.h removes temporaries).
 extern "C" void OnInterrupt(int signal_number) {
   if (interrupted) {
     RemoveTemporaryFilesAndDie(signal_number);

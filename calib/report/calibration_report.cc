@@ -10,7 +10,7 @@
 
 #include "calib/image_file.h"
 #include "calib/report/plot.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 
 namespace omnical {
 namespace {

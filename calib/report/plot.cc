@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
 
 namespace omnical {

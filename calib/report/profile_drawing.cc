@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
 #include "calib/report/plot.h"
 

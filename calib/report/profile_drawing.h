@@ -7,13 +7,13 @@
 #include <string>
 #include <vector>
 
-#include "model/profile_table.h"
+#include "model/io/profile_table.h"
 
 namespace omnical {
 
 struct ProfileDrawing {
   std::string title;               // e.g. "omnical design fit: polynomial, equidistant"
-  ProfileTable profile;            // from the vertex to the rim (model/profile_table.h)
+  ProfileTable profile;            // from the vertex to the rim (model/io/profile_table.h)
   std::vector<std::string> notes;  // lines printed under the table (lens distance, source)
   int stations = 16;               // ordinate rows, evenly spaced in radius, rim included
 };

@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "model/input_error.h"
-#include "model/json_file.h"
+#include "model/io/json_file.h"
 
 namespace omnical {
 

@@ -7,8 +7,9 @@
 
 #include "calib/synthetic/ground_truth.h"
 #include "correction/pixel_ray_grid.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 

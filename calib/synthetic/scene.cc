@@ -6,7 +6,8 @@
 #include <random>
 
 #include "model/input_error.h"
-#include "model/yaml_field_reader.h"
+#include "model/io/yaml_field_reader.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

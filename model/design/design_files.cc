@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 
 namespace omnical {
 namespace {

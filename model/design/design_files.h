@@ -1,5 +1,5 @@
 // The files the design and optics jobs write besides the profile table
-// (model/profile_table.h) and the figures (calib/report): JSON summaries and CSV curves.
+// (model/io/profile_table.h) and the figures (calib/report): JSON summaries and CSV curves.
 // Each writes atomically and throws InputError naming the path when it cannot.
 #pragma once
 

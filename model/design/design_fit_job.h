@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "model/design/mirror_design_fit.h"
-#include "model/profile_table.h"
+#include "model/io/profile_table.h"
 #include "model/progress.h"
 #include "model/sensor.h"
 

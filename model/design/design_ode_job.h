@@ -10,7 +10,7 @@
 
 #include "model/design/designed_sensor.h"
 #include "model/design/mirror_design_ode.h"
-#include "model/profile_table.h"
+#include "model/io/profile_table.h"
 #include "model/progress.h"
 #include "model/sensor.h"
 

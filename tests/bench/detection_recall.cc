@@ -15,7 +15,8 @@
 #include "calib/detect.h"
 #include "calib/synthetic/ground_truth.h"
 #include "calib/refine_corners.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
+#include "model/io/sensor_yaml.h"
 
 int main() {
   using namespace omnical;

@@ -19,7 +19,8 @@
 #include "calib/detect.h"
 #include "calib/synthetic/ground_truth.h"
 #include "correction/viewpoint_error.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

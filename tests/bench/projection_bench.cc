@@ -14,6 +14,7 @@
 #include <random>
 
 #include "model/sensor.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

@@ -24,8 +24,9 @@
 
 #include "correction/remap_table.h"
 #include "correction/viewpoint_error.h"
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/optics.h"
+#include "model/io/sensor_yaml.h"
 
 namespace omnical {
 namespace {

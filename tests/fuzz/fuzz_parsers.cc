@@ -20,12 +20,13 @@
 #include "correction/map_export.h"
 #include "calib/synthetic/scene.h"
 #include "correction/maps_json.h"
-#include "model/csv_reader.h"
-#include "model/design_spec_yaml.h"
+#include "model/io/csv_reader.h"
+#include "model/design/design_spec_yaml.h"
 #include "model/input_error.h"
-#include "model/profile_table.h"
+#include "model/io/profile_table.h"
 #include "model/sensor.h"
 #include "model/tabulated_profile.h"
+#include "model/io/sensor_yaml.h"
 
 namespace {
 

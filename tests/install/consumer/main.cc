@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "model/sensor.h"
+#include "model/io/sensor_yaml.h"
 
 int main(int argc, char** argv) {
   if (argc != 2) return 2;

@@ -1,4 +1,4 @@
-#include "model/json_file.h"
+#include "model/io/json_file.h"
 
 #include <filesystem>
 #include <fstream>

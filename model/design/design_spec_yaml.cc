@@ -1,8 +1,8 @@
-#include "model/design_spec_yaml.h"
+#include "model/design/design_spec_yaml.h"
 
-#include "model/csv_reader.h"
+#include "model/io/csv_reader.h"
 #include "model/input_error.h"
-#include "model/yaml_field_reader.h"
+#include "model/io/yaml_field_reader.h"
 
 namespace omnical {
 

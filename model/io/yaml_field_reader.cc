@@ -1,4 +1,4 @@
-#include "model/yaml_field_reader.h"
+#include "model/io/yaml_field_reader.h"
 
 #include <cmath>
 #include <filesystem>

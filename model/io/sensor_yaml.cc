@@ -8,11 +8,11 @@
 #include <set>
 #include <sstream>
 
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 #include "model/input_error.h"
-#include "model/profile_table.h"
-#include "model/sensor.h"
-#include "model/yaml_field_reader.h"
+#include "model/io/profile_table.h"
+#include "model/io/sensor_yaml.h"
+#include "model/io/yaml_field_reader.h"
 
 namespace omnical {
 namespace {
@@ -155,100 +155,6 @@ SensorModel ReadMirror(const FieldReader& reader, const YAML::Node& root, const 
 
 }  // namespace
 
-namespace {
-
-std::string Describe(const char* format, double a, double b = 0.0) {
-  char text[200];
-  std::snprintf(text, sizeof text, format, a, b);
-  return text;
-}
-
-// The distortion r (1 + k1 r^2 + k2 r^4) must be monotone, and not nearly flat, wherever it
-// is used: up to the undistorted radius of the mirror's outermost point (projection) and up
-// to the distorted radius of the image corners (unprojection). Its slope
-// 1 + 3 k1 u + 5 k2 u^2 (u = r^2) is a quadratic, so the first u where it drops to
-// kMinSlope is found exactly.
-std::string CheckDistortion(const PinholeLens<double>& lens, double max_undistorted, double max_distorted) {
-  constexpr double kMinSlope = 0.1;  // below this the inverse amplifies errors > 10x
-  const double a = 5.0 * lens.k2, b = 3.0 * lens.k1, c = 1.0 - kMinSlope;
-  double u_fold = HUGE_VAL;
-  if (a == 0.0) {
-    if (b < 0.0) u_fold = -c / b;
-  } else {
-    const double disc = b * b - 4.0 * a * c;
-    if (disc >= 0.0) {
-      const double root = std::sqrt(disc);
-      for (double u : {(-b - root) / (2.0 * a), (-b + root) / (2.0 * a)})
-        if (u > 0.0) u_fold = std::min(u_fold, u);
-    }
-  }
-  if (!std::isfinite(u_fold)) return {};
-  const double r_fold = std::sqrt(u_fold);
-  const double rd_fold = r_fold * (1.0 + u_fold * (lens.k1 + u_fold * lens.k2));
-  if (r_fold <= max_undistorted || rd_fold <= max_distorted)
-    return Describe("camera.k1: radial distortion (k1, k2) folds or flattens (slope < 0.1) at normalised radius %.4g, "
-                    "inside the image or the mirror's image",
-                    r_fold);
-  return {};
-}
-
-}  // namespace
-
-std::string ValidateSensorModel(const SensorModel& model) {
-  return std::visit(
-      [](const auto& m) -> std::string {
-        using Model = std::decay_t<decltype(m)>;
-        if (std::string why = m.mirror.CheckDomain(m.rim_radius_mm); !why.empty()) return "mirror: " + why;
-        if (std::string why = m.lens.CheckDomain(); !why.empty()) return "camera: " + why;
-        const Eigen::Matrix3d rotation = m.pose.CameraFromMirrorRotation();
-        const Eigen::Vector3d translation = m.pose.CameraFromMirrorTranslation();
-        const Eigen::Vector3d lens_in_mirror = -(rotation.transpose() * translation);
-        const Eigen::Vector3d lens_direction = -rotation.row(2).transpose();  // orthographic
-        const double r2_lens = lens_in_mirror.head<2>().squaredNorm();
-        if (r2_lens < m.rim_radius_mm * m.rim_radius_mm && !(lens_in_mirror.z() < m.mirror.EvaluateSag(r2_lens).z))
-          return "pose.m: the lens centre lies inside the mirror (m too small for this tilt/decenter)";
-        // The solvers need (1) a mirror convex towards the camera: z' > 0 and z'' > 0 out to the
-        // rim (unique reflection point, monotone Omega); (2) seen from its front all the way to
-        // the rim: the lens on the outer side of every tangent plane (else the rim zone is the
-        // hidden back of the surface); (3) in front of the lens.
-        constexpr int kRadii = 400;
-        const int azimuths = m.IsAxial() ? 1 : 72;
-        double max_tan = 0.0;
-        for (int i = 1; i <= kRadii; ++i) {
-          const double r = m.rim_radius_mm * i / kRadii;
-          const SagDerivatives<double> sag = m.mirror.EvaluateSag(r * r);
-          double slope = 0.0, curvature = 0.0;
-          RadialSlopes(sag, r, &slope, &curvature);
-          if (!(sag.dz_ds > 0.0) || !(curvature > 0.0))
-            return Describe("mirror: the profile is not convex towards the camera at r = %.4g mm (z' = %.3g): "
-                            "omnical's solvers need z' > 0 and z'' > 0 out to the rim",
-                            r, slope);
-          for (int k = 0; k < azimuths; ++k) {
-            const double phi = 2.0 * M_PI * k / azimuths;
-            const Eigen::Vector3d point(r * std::cos(phi), r * std::sin(phi), sag.z);
-            const Eigen::Vector3d normal(slope * std::cos(phi), slope * std::sin(phi), -1.0);  // outward
-            const double facing = Model::kOrthographic ? lens_direction.dot(normal) : (lens_in_mirror - point).dot(normal);
-            if (!(facing > 0.0))
-              return Describe("mirror.rim_radius: the lens sees the mirror edge-on at r = %.4g mm, before the rim "
-                              "(azimuth %.0f deg): rim_radius too large for this profile and pose",
-                              r, phi * 180.0 / M_PI);
-            const Eigen::Vector3d in_camera = rotation * point + translation;
-            if (!(in_camera.z() > 0.0))
-              return Describe("pose: part of the mirror lies behind the lens plane (r = %.4g mm, azimuth %.0f deg)", r,
-                              phi * 180.0 / M_PI);
-            max_tan = std::max(max_tan, in_camera.head<2>().norm() / in_camera.z());
-          }
-        }
-        if constexpr (!Model::kOrthographic) {
-          const double corner_u = std::max(std::abs(m.lens.cx_px + 0.5), std::abs(m.image_width_px - 0.5 - m.lens.cx_px));
-          const double corner_v = std::max(std::abs(m.lens.cy_px + 0.5), std::abs(m.image_height_px - 0.5 - m.lens.cy_px));
-          const double max_distorted = std::hypot(corner_u / m.lens.fx_px, corner_v / m.lens.fy_px);
-          if (std::string why = CheckDistortion(m.lens, max_tan, max_distorted); !why.empty()) return why;
-        }
-        return {};
-      },
-      model);
-}
 
 namespace {
 

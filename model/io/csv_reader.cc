@@ -1,4 +1,4 @@
-#include "model/csv_reader.h"
+#include "model/io/csv_reader.h"
 
 #include <cerrno>
 #include <cmath>

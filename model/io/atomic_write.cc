@@ -1,4 +1,4 @@
-#include "model/atomic_write.h"
+#include "model/io/atomic_write.h"
 
 #include <unistd.h>
 

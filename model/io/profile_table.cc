@@ -1,12 +1,12 @@
-#include "model/profile_table.h"
+#include "model/io/profile_table.h"
 
 #include <cmath>
 #include <iomanip>
 #include <ostream>
 #include <stdexcept>
 
-#include "model/atomic_write.h"
-#include "model/csv_reader.h"
+#include "model/io/atomic_write.h"
+#include "model/io/csv_reader.h"
 #include "model/input_error.h"
 
 namespace omnical {
