@@ -94,13 +94,12 @@ BoardScale CheckBoardScale(const Sensor& sensor, const CalibrationTarget& target
   // The fit lets reflections stray 15 % past the rim; so does this check.
   const Sensor wide = SensorWithWiderRim(sensor, 1.15);
   for (ScaledCornerError& corner : corners) corner.sensor = &wide;
-  const double reference = options.reference_scale;
-  const Fitted at_target = FitAtScale(corners, pose, reference, true);
+  const Fitted at_target = FitAtScale(corners, pose, 1.0, true);
   Fitted best = at_target;
   // Starts spread over sizes (the scale's cost can have a minimum per basin): the target's,
   // a quarter and four times it.
   for (double start : {0.25, 1.0, 4.0}) {
-    const Fitted fitted = FitAtScale(corners, pose, start * reference, false);
+    const Fitted fitted = FitAtScale(corners, pose, start, false);
     if (fitted.sum_px2 < best.sum_px2) best = fitted;
   }
   result.best_scale = best.scale;
@@ -108,15 +107,14 @@ BoardScale CheckBoardScale(const Sensor& sensor, const CalibrationTarget& target
   result.rms_at_target_px = std::sqrt(at_target.sum_px2 / corners.size());
   result.rms_at_best_px = std::sqrt(best.sum_px2 / corners.size());
   const double chi2 = (at_target.sum_px2 - best.sum_px2) / (sigma_px * sigma_px);
-  const double ratio = best.scale / reference;
-  const bool other_size = ratio > options.max_size_ratio || ratio < 1.0 / options.max_size_ratio;
+  const bool other_size = best.scale > options.max_size_ratio || best.scale < 1.0 / options.max_size_ratio;
   if (other_size && chi2 > options.min_chi2) {
     result.refused = true;
     char text[240];
     std::snprintf(text, sizeof text,
                   "fits as a board %.2f x the target's size at %.0f mm (RMS %.3f px, against %.3f px at the target's "
                   "size): not the calibration target",
-                  ratio, best.distance_mm, result.rms_at_best_px, result.rms_at_target_px);
+                  best.scale, best.distance_mm, result.rms_at_best_px, result.rms_at_target_px);
     result.reason = text;
   }
   return result;

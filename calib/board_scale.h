@@ -24,11 +24,6 @@ namespace omnical {
 struct BoardScaleOptions {
   double max_size_ratio = 1.5;
   double min_chi2 = 25.0;
-  // The board size (x the target's) the sensor's own scale implies: 1 for a sensor in
-  // millimetres (a design guess), but a fit started from the rim circle alone holds an
-  // arbitrary scale (only scale x mirror size is observable through its lens), so every
-  // board looks alike off by it: the median of the views' best sizes then.
-  double reference_scale = 1.0;
 };
 
 struct BoardScale {

@@ -754,7 +754,7 @@ FitOptions FitOptions::DefaultsFor(const Sensor& sensor) {
   if (std::string(sensor.profile_name()) == "sphere") options.fixed.insert("tilt");
   // A free polynomial mirror bends the radial mapping as the lens's radial distortion
   // does: k1, k2 are held and the mirror shape absorbs them. (Its fx is observable but
-  // weakly: another fx with another polynomial looks almost the same; see the README.)
+  // weakly: another fx with another polynomial looks almost the same; see docs/calibrate.md "What the data can observe".)
   if (std::string(sensor.profile_name()) == "polynomial" && std::string(sensor.lens_name()) == "pinhole")
     options.fixed.insert("distortion");
   return options;

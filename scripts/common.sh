@@ -8,7 +8,7 @@ omnical_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build_dir=${OMNICAL_BUILD_DIR:-$omnical_root/build/${omnical_build_kind:-test}}
 jobs=${OMNICAL_JOBS:-$(nproc)}
 
-# Why each package is here: see README "Dependencies".
+# Why each package is here: see docs/dependencies.md.
 omnical_packages=(
   g++ cmake ninja-build pkg-config
   libeigen3-dev libceres-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libboost-dev

@@ -151,7 +151,7 @@ TEST(BundleFit, RecoversAMisalignedPolynomialMirrorFromExactObservations) {
 // the standard deviations themselves.
 // The misaligned sphere (a rigid profile whose one gauge, tilt, is fixed) with m known from
 // the mechanical design; see the note inside. Under those conditions the linearised
-// standard deviations describe the error. (README "What the data can observe".)
+// standard deviations describe the error. (docs/calibrate.md "What the data can observe".)
 void NoisyFitHolds(bool with_outliers) {
   const Truth truth = MixedDistanceObservations(
       LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-sph-misaligned.yaml"));

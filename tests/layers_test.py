@@ -1,5 +1,7 @@
 #!/usr/bin/env python3
-"""Fails when a source file includes a header from a layer it may not use (docs/layers.md).
+"""Fails when a source file includes a header from a layer it may not use (docs/layers.md),
+and when the CLI stops being thin (a subcommand over 150 lines, tools/ over a quarter of
+the library).
 
 Usage: layers_test.py SOURCE_DIR            check the tree
        layers_test.py SOURCE_DIR --self-test  also check that planted violations are caught
@@ -71,6 +73,36 @@ def check(root, layers):
     return problems
 
 
+def front_end_is_thin(root, layers):
+    """The CLI parses, calls, prints: no subcommand file over 150 lines, and tools/ under a
+    quarter of the library's lines (the library layers of the table)."""
+    problems = []
+    def lines(path):
+        with open(path, errors="replace") as f:
+            return sum(1 for _ in f)
+    library = cli = 0
+    for name, directory, _, _ in layers:
+        if name == "tests":
+            continue
+        for folder, _, files in os.walk(os.path.join(root, directory)):
+            for file in files:
+                if not file.endswith((".h", ".cc")):
+                    continue
+                path = os.path.join(folder, file)
+                if layer_of(os.path.relpath(path, root), layers)[0] != name:
+                    continue
+                count = lines(path)
+                if name == "cli":
+                    cli += count
+                    if file.startswith("cmd_") and file.endswith(".cc") and count > 150:
+                        problems.append(f"{os.path.relpath(path, root)}: {count} lines (a subcommand stays under 150)")
+                else:
+                    library += count
+    if library and cli >= library / 4:
+        problems.append(f"tools/: {cli} lines, not under a quarter of the library's {library}")
+    return problems, cli, library
+
+
 def self_test(root, layers):
     """The checker must catch a planted bad edge and a planted third-party header."""
     with tempfile.TemporaryDirectory() as tmp:
@@ -94,11 +126,14 @@ def main():
     if "--self-test" in sys.argv:
         self_test(root, layers)
     problems = check(root, layers)
+    thin, cli, library = front_end_is_thin(root, layers)
+    problems += thin
     for p in problems:
         print(p)
     if problems:
         sys.exit(f"layers_test: {len(problems)} include(s) cross the layer table (docs/layers.md)")
-    print(f"layers_test: {len(layers)} layers, every include allowed")
+    print(f"layers_test: {len(layers)} layers, every include allowed; tools/ {cli} lines, "
+          f"{100.0 * cli / library:.1f}% of the library's {library}; every subcommand under 150 lines")
 
 
 if __name__ == "__main__":

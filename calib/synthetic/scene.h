@@ -1,5 +1,5 @@
 // A synthetic scene for `omnical render`: a sensor, planar targets placed around it per
-// view, an environment, and the image formation settings (YAML, see README "Scene file").
+// view, an environment, and the image formation settings (YAML, see docs/file-formats.md "Scene file").
 //
 // Target placement (mirror frame): the board centre sits at distance_mm from the mirror
 // vertex in the direction (Omega, azimuth) of the seed paper (Omega from the -z axis), its

@@ -1,4 +1,4 @@
-// The profile table file of a tabulated mirror (CSV, mm; README "Sensor file"): rows
+// The profile table file of a tabulated mirror (CSV, mm; docs/file-formats.md "Profile tables"): rows
 // "x_mm, z_mm[, dz_dx]" from the vertex (x = 0, z = 0) to the rim, after an optional
 // header and '#' comment lines. Read and written here, so the format lives in one place.
 #pragma once
