@@ -24,9 +24,9 @@ struct Flags {
 
 void Run(const Flags& flags, const Context& context) {
   const Sensor sensor = LoadSensorYaml(flags.sensor_path);
-  const FieldFlags names = {{"lens_focal_mm", "--lens-f"}, {"focus_mm", "--focus-mm"}, {"f_number", "--f-number"},
+  const FlagTable names = {{"lens_focal_mm", "--lens-f"}, {"focus_mm", "--focus-mm"}, {"f_number", "--f-number"},
                             {"pixel_um", "--pixel-um"},    {"near_n", "--near-n"},     {"samples", "--samples"}};
-  const CharacterizeResult r = WithFlags(names, [&] {
+  const CharacterizeResult r = NamingFlagWords(names, [&] {
     try {
       return Characterize(sensor, flags.job);
     } catch (const InputError& e) {  // "sensor: ..." is about the sensor file

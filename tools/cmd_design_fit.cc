@@ -62,12 +62,12 @@ void RunDesignFit(DesignFitFlags& f, const Context& context) {
     }
     o.compare_source = f.compare_path;
   }
-  const FieldFlags flags = {{"rim_omega_deg", "--rim-omega"},
+  const FlagTable flags = {{"rim_omega_deg", "--rim-omega"},
                             {"rim_theta_deg", "--rim-theta"},
                             {"polynomial_terms", "--terms"},
                             {"rim_radius_mm", "--rim-radius-mm"},
                             {"image_size_px", "--image-size"}};
-  const DesignFitResult r = WithFlags(flags, [&] { return DesignMirrorFit(o); });
+  const DesignFitResult r = NamingFlagWords(flags, [&] { return DesignMirrorFit(o); });
 
   const std::filesystem::path dir(f.out_dir);
   CreateOutputDirectory(dir);

@@ -1,6 +1,7 @@
 #include "tools/field_flags.h"
 
 #include <algorithm>
+#include <cctype>
 
 namespace omnical::cli {
 
@@ -26,6 +27,22 @@ std::string FlagMessage(const std::string& message, const FlagTable& flags) {
     start = slash + 1;
   }
   return named + message.substr(colon);
+}
+
+std::string FlagWords(std::string message, const FlagTable& flags) {
+  auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  for (const auto& [field, flag] : flags) {
+    for (size_t at = message.find(field); at != std::string::npos; at = message.find(field, at)) {
+      const size_t end = at + field.size();
+      if ((at > 0 && (word(message[at - 1]) || message[at - 1] == '-')) || (end < message.size() && word(message[end]))) {
+        at = end;
+        continue;
+      }
+      message.replace(at, field.size(), flag);
+      at += flag.size();
+    }
+  }
+  return message;
 }
 
 }  // namespace omnical::cli

@@ -3,9 +3,7 @@
 // and runs its library call through NamingFlags.
 #pragma once
 
-#include <cctype>
 #include <map>
-#include <vector>
 #include <string>
 #include <utility>
 
@@ -35,34 +33,16 @@ auto NamingFlags(const FlagTable& flags, Job&& job) -> decltype(job()) {
 }
 
 // For messages that name fields inside the text too ("rim_omega_deg: must lie between
-// rim_theta_deg and 180"): every whole-word field replaced by its flag.
-using FieldFlags = std::vector<std::pair<std::string, std::string>>;  // {field, flag}
+// rim_theta_deg and 180"): every whole-word field replaced by its flag. Only for tables
+// whose field names cannot be ordinary words (not "n").
+std::string FlagWords(std::string message, const FlagTable& flags);
 
-// Every whole-word occurrence of a field replaced by its flag.
-inline std::string FieldsAsFlags(std::string message, const FieldFlags& names) {
-  auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
-  for (const auto& [field, flag] : names) {
-    for (size_t at = message.find(field); at != std::string::npos; at = message.find(field, at)) {
-      const size_t end = at + field.size();
-      if ((at > 0 && (word(message[at - 1]) || message[at - 1] == '-')) ||
-          (end < message.size() && word(message[end]))) {
-        at = end;
-        continue;
-      }
-      message.replace(at, field.size(), flag);
-      at += flag.size();
-    }
-  }
-  return message;
-}
-
-// Runs a library call, rethrowing its InputError with the fields named as flags.
-template <typename Call>
-auto WithFlags(const FieldFlags& names, Call&& call) -> decltype(call()) {
+template <typename Job>
+auto NamingFlagWords(const FlagTable& flags, Job&& job) -> decltype(job()) {
   try {
-    return call();
-  } catch (const InputError& e) {
-    throw InputError(FieldsAsFlags(e.what(), names));
+    return std::forward<Job>(job)();
+  } catch (const InputError& error) {
+    throw InputError(FlagWords(error.what(), flags));
   }
 }
 
