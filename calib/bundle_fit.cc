@@ -1,4 +1,5 @@
 #include "calib/bundle_fit.h"
+#include "model/ceres_progress.h"
 
 #include "model/input_error.h"
 
@@ -415,13 +416,22 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
   solver.parameter_tolerance = 1e-15;
   solver.num_threads = 2;
   solver.logging_type = ceres::SILENT;
+  // One progress step per solver iteration; a cancel aborts the solve and throws.
+  ProgressReporter progress(options.progress, "fit", 0);
+  progress.ThrowIfCancelled();
+  IterationProgress iteration_progress(&progress);
+  solver.callbacks.push_back(&iteration_progress);
   ceres::Solver::Summary summary;
+  auto solve = [&]() {
+    ceres::Solve(solver, &problem, &summary);
+    progress.ThrowIfCancelled();
+  };
   // Stage 0: the poses alone, through the guessed sensor.
   if (!options.fixed.count("poses")) {
     problem.SetParameterBlockConstant(lens.data());
     set_sensor(false);
     set_poses(true);
-    ceres::Solve(solver, &problem, &summary);
+    solve();
   }
   // Stage 1: everything but the distortion; stage 2: everything asked for. The priors
   // weigh against the residuals left by the stage before (while the start is poor they are
@@ -431,11 +441,11 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
   set_sensor(true);
   if (!distortion.empty()) {
     set_lens(true);
-    ceres::Solve(solver, &problem, &summary);
+    solve();
     prior_noise_px = std::max(1e-3, robust_sigma(residual_norms()));
   }
   set_lens(false);
-  ceres::Solve(solver, &problem, &summary);
+  solve();
   // Gross outliers (robust mode): beyond max(floor, k sigma) of a robust sigma, removed and
   // the fit repeated without them, under Huber. A view left with too few corners goes.
   if (options.robust_loss_px > 0.0) {
@@ -489,7 +499,7 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
     }
     loss->Reset(new ceres::HuberLoss(options.robust_loss_px), ceres::TAKE_OWNERSHIP);
     prior_noise_px = std::max(1e-3, robust_sigma(residual_norms()));
-    ceres::Solve(solver, &problem, &summary);
+    solve();
   }
 
   // Plain residuals at the solution; the statistics are over the inliers.
@@ -519,7 +529,7 @@ FitResult FitModel(const Model& guess, const CalibrationTarget& target, const De
   // The priors' final weight: the noise the covariance is scaled by (so the two agree).
   if (!priors.empty() && std::abs(result.sigma_px - prior_noise_px) > 0.05 * prior_noise_px) {
     prior_noise_px = std::max(1e-6, result.sigma_px);
-    ceres::Solve(solver, &problem, &summary);
+    solve();
     result.sigma_px = statistics();
   }
   result.converged = summary.termination_type == ceres::CONVERGENCE;

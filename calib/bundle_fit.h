@@ -28,6 +28,7 @@
 
 #include "calib/detections.h"
 #include "calib/target.h"
+#include "model/progress.h"
 #include "model/sensor.h"
 
 namespace omnical {
@@ -58,6 +59,8 @@ struct FitOptions {
   // a parameter not named here is centred on the guess's value. A pipeline that fits
   // several times (a second detection pass from the first fit) keeps the user's design.
   std::map<std::string, double> design;
+  // Stage "fit", one step per solver iteration; returning false cancels (Cancelled).
+  ProgressCallback progress;
 
   // The gauge-fixing defaults for a sensor (see above).
   static FitOptions DefaultsFor(const Sensor& sensor);

@@ -144,6 +144,7 @@ FitOptions FitOptionsFor(const CalibrationInput& input, const CalibrationOptions
   for (const auto& [name, value] : ExpandTolerances(options.tolerances)) fit.tolerances[name] = value;
   if (const std::string why = fit.CheckFor(start); !why.empty()) throw InputError("tolerances: " + why);
   for (const ParameterEstimate& p : SensorParameters(start)) fit.design[p.name] = p.value;
+  fit.progress = options.progress;
   return fit;
 }
 
@@ -153,6 +154,7 @@ std::map<std::string, CalibrationRecord::Spread> LeaveOneOut(const Sensor& start
                                                               const ProgressCallback& callback) {
   std::map<std::string, std::vector<double>> folds;
   quick.compute_covariance = false;
+  quick.progress = nullptr;  // the folds report as one stage, checked between fits
   ProgressReporter progress(callback, "leave-one-out", static_cast<long>(views.detections.images.size()));
   for (size_t left_out = 0; left_out < views.detections.images.size(); ++left_out) {
     DetectionSet subset = views.detections;
@@ -180,7 +182,7 @@ std::map<std::string, CalibrationRecord::Spread> LeaveOneOut(const Sensor& start
 std::string CalibrationOptions::Check() const {
   static const std::set<std::string> kProfiles = {"", "sphere", "paraboloid", "polynomial", "hyperboloid"};
   if (!kProfiles.count(profile)) return "profile: unknown mirror family '" + profile + "' (sphere, paraboloid, polynomial, hyperboloid)";
-  if (!(rim_field_deg >= 10.0 && rim_field_deg <= 170.0)) return "rim_field_deg: must be in [10, 170]";
+  if (!(rim_field_deg > 10.0 && rim_field_deg < 170.0)) return "rim_field_deg: must lie in (10, 170) deg";
   if (!(loss_px >= 0.0 && std::isfinite(loss_px))) return "loss_px: must be >= 0 and finite";
   if (max_iterations < 1) return "max_iterations: must be >= 1";
   if (detection_passes < 1) return "detection_passes: must be >= 1";
@@ -239,9 +241,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   int unrefined = 0;
   UsableViews views = ViewsForFit(guess, input, FittableCorners(input, detections, &unrefined), &warnings);
   std::optional<Sensor> refit_start;  // the previous pass's fit, where the last fit started
-  ProgressReporter passes(options.progress, "fit", 1);
   FitResult fit = FitSensor(guess, input.target, views.detections, views.poses, fit_options);
-  passes.Step();
   // Second detection pass (aprilgrid from images): the corners are refined in patches
   // through a sensor, and a tag's straight edges are straight there only as far as that
   // sensor is right. Through the design guess the patch edges bend, and the corners
@@ -255,7 +255,6 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     detections = std::move(found.detections);
     views = ViewsForFit(*refit_start, input, FittableCorners(input, detections, &unrefined), &warnings);
     fit = FitSensor(*refit_start, input.target, views.detections, views.poses, fit_options);
-    ProgressReporter(options.progress, "fit", 1).Step();
   }
   const Sensor& fit_start = refit_start ? *refit_start : guess;
   // Boards of another size than the target (a decoy the detector accepted, e.g. a window

@@ -124,7 +124,7 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
     r.sigma_px = at("sigma_px").get<double>();
     if (!at("tolerances").is_null()) r.tolerances = at("tolerances").get<DesignTolerances>();
     r.guess_rim_radius_mm = at("rim_radius_mm").at("guess").get<double>();
-    r.fitted_rim_radius_mm = j["rim_radius_mm"].at("fitted").get<double>();
+    r.fitted_rim_radius_mm = j.at("rim_radius_mm").at("fitted").get<double>();
     if (j.contains("covariance")) {
       const json& c = at("covariance");
       r.covariance_names = c.at("names").get<std::vector<std::string>>();
@@ -139,7 +139,8 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
                                      NumberOrNan(p.at("median_px")), NumberOrNan(p.at("max_px")),
                                      p.at("field_pixels").get<int>(), p.at("unpredicted_pixels").get<int>()});
     r.warnings = at("warnings").get<std::vector<std::string>>();
-    if (j.contains("per_view_rms_px")) r.per_view_rms_px = at("per_view_rms_px").get<std::map<std::string, double>>();
+    if (j.contains("per_view_rms_px"))  // a view left out has no RMS: null
+      for (const auto& [image, rms] : at("per_view_rms_px").items()) r.per_view_rms_px[image] = NumberOrNan(rms);
     for (const auto& [parameter, p] : at("parameters").items())
       r.parameters.push_back({parameter, p.at("value").get<double>(), NumberOrNan(p.at("std")), p.at("fixed").get<bool>()});
     if (j.contains("poses"))

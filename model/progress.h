@@ -5,6 +5,7 @@
 #pragma once
 
 #include <atomic>
+#include <exception>
 #include <functional>
 #include <mutex>
 #include <stdexcept>
@@ -42,8 +43,12 @@ class ProgressReporter {
   // False once the caller asked to stop.
   bool Advance(long amount = 1) { return Report(done_ += amount); }
   bool cancelled() const { return cancelled_; }
+  // Rethrows what the callback threw (it may run on a worker thread, where an exception
+  // would end the process), else Cancelled.
   void ThrowIfCancelled() const {
-    if (cancelled_) throw Cancelled(stage_);
+    if (!cancelled_) return;
+    if (thrown_) std::rethrow_exception(thrown_);
+    throw Cancelled(stage_);
   }
   // Advance, then throw if cancelled: for single-threaded loops.
   void Step(long amount = 1) {
@@ -56,7 +61,12 @@ class ProgressReporter {
     if (cancelled_) return false;
     if (!callback_) return true;
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!callback_({stage_, done, total_})) cancelled_ = true;
+    try {
+      if (!callback_({stage_, done, total_})) cancelled_ = true;
+    } catch (...) {
+      if (!thrown_) thrown_ = std::current_exception();
+      cancelled_ = true;
+    }
     return !cancelled_;
   }
   ProgressCallback callback_;
@@ -64,6 +74,7 @@ class ProgressReporter {
   long total_;
   std::atomic<long> done_{0};
   std::atomic<bool> cancelled_{false};
+  std::exception_ptr thrown_;  // guarded by mutex_; read once the workers are joined
   std::mutex mutex_;
 };
 

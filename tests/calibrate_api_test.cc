@@ -110,6 +110,24 @@ TEST(CalibrateApi, RecordRoundTripsThroughCalibrationJson) {
   EXPECT_EQ(back.predicted_error[0].max_px, result.record.predicted_error[0].max_px);
 }
 
+// A view whose corners are all wrong is left out: its RMS is written as null and must read
+// back (as NaN), with the rest of the record.
+TEST(CalibrateApi, RecordWithAViewLeftOutRoundTrips) {
+  CalibrationInput input = InputFromTruth();
+  // Every corner of view 3 moved 40 px in a direction that turns from corner to corner.
+  std::vector<CornerObservation>& corners = input.detections->images[3].corners;
+  for (size_t k = 0; k < corners.size(); ++k) corners[k].pixel += 40.0 * Eigen::Vector2d(std::cos(2.4 * k), std::sin(2.4 * k));
+  const CalibrationResult result = Calibrate(input, CalibrationOptions());
+  ASSERT_EQ(result.record.views_left_out.size(), 1u);
+  const std::string image = result.record.views_left_out.begin()->first;
+  ASSERT_EQ(result.record.per_view_rms_px.count(image), 1u) << result.record.views_left_out.begin()->second;
+  EXPECT_TRUE(std::isnan(result.record.per_view_rms_px.at(image)));
+  const CalibrationRecord back = ParseCalibrationJson(CalibrationJsonText(result.record), "memory");
+  EXPECT_TRUE(std::isnan(back.per_view_rms_px.at(image)));
+  EXPECT_EQ(back.poses.count(image), 0u);
+  EXPECT_EQ(CalibrationJsonText(back), CalibrationJsonText(result.record));
+}
+
 TEST(CalibrateApi, BadOptionsAndInputsNameTheField) {
   CalibrationOptions options;
   options.fixed = {"focal"};

@@ -12,6 +12,7 @@
 #include "model/input_error.h"
 #include "tools/commands.h"
 #include "tools/field_flags.h"
+#include "tools/progress.h"
 #include "model/io/sensor_yaml.h"
 
 namespace omnical::cli {
@@ -28,7 +29,9 @@ void Run(const Flags& flags, const Context& context) {
                             {"pixel_um", "--pixel-um"},    {"near_n", "--near-n"},     {"samples", "--samples"}};
   const CharacterizeResult r = NamingFlagWords(names, [&] {
     try {
-      return Characterize(sensor, flags.job);
+      CharacterizeOptions job = flags.job;
+      job.progress = TerminalProgress(context);
+      return Characterize(sensor, job);
     } catch (const InputError& e) {  // "sensor: ..." is about the sensor file
       const std::string what = e.what();
       if (what.rfind("sensor: ", 0) != 0) throw;

@@ -13,6 +13,7 @@
 #include "model/input_error.h"
 #include "tools/cmd_design_fit.h"
 #include "tools/commands.h"
+#include "tools/progress.h"
 
 namespace omnical::cli {
 namespace {
@@ -37,6 +38,7 @@ void RunOde(OdeFlags& flags, const Context& context) {
       LoadLawTable(flags.law_table, &spec.law);
     }
   }
+  job.progress = TerminalProgress(context);
   const DesignOdeResult r = DesignMirrorOde(job);
   const std::filesystem::path dir(flags.out_dir);
   CreateOutputDirectory(dir);

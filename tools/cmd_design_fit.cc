@@ -13,6 +13,7 @@
 #include "model/design/design_files.h"
 #include "model/input_error.h"
 #include "tools/field_flags.h"
+#include "tools/progress.h"
 #include "model/io/sensor_yaml.h"
 
 namespace omnical::cli {
@@ -67,6 +68,7 @@ void RunDesignFit(DesignFitFlags& f, const Context& context) {
                             {"polynomial_terms", "--terms"},
                             {"rim_radius_mm", "--rim-radius-mm"},
                             {"image_size_px", "--image-size"}};
+  o.progress = TerminalProgress(context);
   const DesignFitResult r = NamingFlagWords(flags, [&] { return DesignMirrorFit(o); });
 
   const std::filesystem::path dir(f.out_dir);

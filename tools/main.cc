@@ -79,6 +79,9 @@ int main(int argc, char** argv) {
   try {
     for (const auto& [sub, action] : actions)
       if (sub->parsed()) action();
+    // Interrupted after the job's last progress report: its outputs are complete, but the
+    // run still ends the way the signal would have.
+    if (cli::InterruptRequested()) throw Cancelled("the last step");
   } catch (const InputError& error) {
     std::cerr << "omnical: error: " << error.what() << "\n";
     return 2;

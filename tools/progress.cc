@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -31,11 +32,20 @@ struct Bar {
   std::mutex mutex;
   std::string stage;
   long done = -1, total = 0;
+  bool open = false;  // a line drawn and not ended
   std::chrono::steady_clock::time_point last;
+  ~Bar() {
+    if (open) std::fputc('\n', stderr);
+  }
   void Draw() {
-    const int percent = total > 0 ? static_cast<int>(100 * done / total) : 100;
-    std::fprintf(stderr, "\r%s: %3d%% (%ld/%ld)", stage.c_str(), percent, done, total);
+    if (total > 0) {
+      std::fprintf(stderr, "\r%s: %3d%% (%ld/%ld)", stage.c_str(), static_cast<int>(100 * std::min(done, total) / total),
+                   done, total);
+    } else {
+      std::fprintf(stderr, "\r%s: %ld", stage.c_str(), done);  // steps of unknown number (solver iterations)
+    }
     std::fflush(stderr);
+    open = true;
   }
 };
 
@@ -83,17 +93,22 @@ ProgressCallback TerminalProgress(const Context& context) {
     std::lock_guard<std::mutex> lock(bar->mutex);
     const auto now = std::chrono::steady_clock::now();
     if (update.stage != bar->stage) {
-      if (!bar->stage.empty()) std::fputc('\n', stderr);
+      if (bar->open) std::fputc('\n', stderr);
+      bar->open = false;
       bar->stage = update.stage;
+      bar->done = -1;
       bar->last = {};
     }
-    bar->done = update.done, bar->total = update.total;
-    if (update.done >= update.total || now - bar->last >= std::chrono::milliseconds(100)) {
+    bar->done = std::max(bar->done, update.done), bar->total = update.total;
+    const bool finished = update.total > 0 && update.done >= update.total;
+    if (finished || now - bar->last >= std::chrono::milliseconds(100)) {
       bar->last = now;
       bar->Draw();
-      if (update.done >= update.total) {
+      if (finished) {
         std::fputc('\n', stderr);
+        bar->open = false;
         bar->stage.clear();
+        bar->done = -1;
       }
     }
     return !InterruptRequested();

@@ -1,4 +1,5 @@
 #include "model/design/mirror_design_fit.h"
+#include "model/ceres_progress.h"
 
 #include <ceres/ceres.h>
 
@@ -126,18 +127,6 @@ struct CharacteristicResiduals {
   }
 };
 
-// Ceres' iteration callback forwarding to a ProgressReporter: a false from the caller
-// aborts the solve.
-class IterationProgress : public ceres::IterationCallback {
- public:
-  explicit IterationProgress(ProgressReporter* reporter) : reporter_(reporter) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
-    return reporter_->Advance() ? ceres::SOLVER_CONTINUE : ceres::SOLVER_ABORT;
-  }
-
- private:
-  ProgressReporter* reporter_;
-};
 
 // The image must be one-to-one: Omega and the image height grow with x, the lens below
 // the mirror.
