@@ -76,15 +76,16 @@ std::optional<CentralModelKind> ParseCentralModelKind(const std::string& name) {
 
 const char* CentralModelKindName(CentralModelKind kind) { return kind == CentralModelKind::kMei ? "mei" : "ocamcalib"; }
 
-void CentralExportOptions::Check() const {
-  if (distance_mm && n) throw InputError("n: give only one of distance_mm and n");
+std::string CentralExportOptions::Check() const {
+  if (distance_mm && n) return "n: give only one of distance_mm and n";
   if (distance_mm || n) {
     const double distance = distance_mm ? *distance_mm : *n;
     if (!std::isfinite(distance) || distance <= 0.0)
-      throw InputError(std::string(n ? "n" : "distance_mm") + ": the object distance must be > 0");
+      return std::string(n ? "n" : "distance_mm") + ": the object distance must be > 0";
   }
-  if (!(step_px >= 1.0)) throw InputError("step_px: must be >= 1");
-  if (v0_mm && !std::isfinite(*v0_mm)) throw InputError("v0_mm: not finite");
+  if (!(step_px >= 1.0)) return "step_px: must be >= 1";
+  if (v0_mm && !std::isfinite(*v0_mm)) return "v0_mm: not finite";
+  return "";
 }
 
 std::string CentralExportResult::FittedForText() const {
@@ -94,7 +95,7 @@ std::string CentralExportResult::FittedForText() const {
 }
 
 CentralExportResult ExportCentral(const Sensor& sensor, const CentralExportOptions& options) {
-  options.Check();
+  if (const std::string why = options.Check(); !why.empty()) throw InputError(why);
   CentralExportResult result;
   result.model = options.model;
   const double rim = result.rim_radius_mm = sensor.rim_radius_mm();

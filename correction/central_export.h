@@ -25,8 +25,8 @@ struct CentralExportOptions {
   double step_px = 8.0;                  // field sampling grid, omni px (>= 1)
   ProgressCallback progress;             // stage "export-central"
 
-  // Throws InputError naming the field.
-  void Check() const;
+  // "" or "field: problem".
+  std::string Check() const;
 };
 
 struct CentralErrorAtDistance {

@@ -14,17 +14,18 @@
 
 namespace omnical {
 
-void ParallaxOptions::Check() const {
-  if (distance_mm.has_value() == n.has_value()) throw InputError("distance_mm: give the object distance (distance_mm or n)");
+std::string ParallaxOptions::Check() const {
+  if (distance_mm.has_value() == n.has_value()) return "distance_mm: give the object distance (distance_mm or n)";
   const double distance = distance_mm ? *distance_mm : *n;
-  if (!(std::isfinite(distance) && distance > 0.0)) throw InputError(std::string(n ? "n" : "distance_mm") + ": must be > 0");
-  if (v0_mm && !std::isfinite(*v0_mm)) throw InputError("v0_mm: not finite");
-  if (samples < 10 || samples > 100000) throw InputError("samples: " + std::to_string(samples) + " (10..100000)");
-  if (threads < 0) throw InputError("threads: must be >= 0");
+  if (!(std::isfinite(distance) && distance > 0.0)) return std::string(n ? "n" : "distance_mm") + ": must be > 0";
+  if (v0_mm && !std::isfinite(*v0_mm)) return "v0_mm: not finite";
+  if (samples < 10 || samples > 100000) return "samples: " + std::to_string(samples) + " (10..100000)";
+  if (threads < 0) return "threads: must be >= 0";
+  return "";
 }
 
 ParallaxResult ParallaxReport(const Sensor& sensor, const ParallaxOptions& options) {
-  options.Check();
+  if (const std::string why = options.Check(); !why.empty()) throw InputError(why);
   ParallaxResult result;
   const double rim = sensor.rim_radius_mm();
   result.distance_mm = options.distance_mm ? *options.distance_mm : *options.n * rim;

@@ -21,8 +21,8 @@ struct ParallaxOptions {
   int threads = 0;                       // 0: all cores
   ProgressCallback progress;             // stage "parallax map" (image rows)
 
-  // Throws InputError naming the field.
-  void Check() const;
+  // "" or "field: problem".
+  std::string Check() const;
 };
 
 struct ParallaxResult {

@@ -13,7 +13,7 @@ namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
-InputError FieldError(const std::string& field, const std::string& problem) { return InputError(field + ": " + problem); }
+std::string FieldMessage(const std::string& field, const std::string& problem) { return field + ": " + problem; }
 
 // "WxH" -> (width, height); false if it is not that.
 bool ParseSize(const std::string& text, int* width, int* height) {
@@ -24,33 +24,34 @@ bool ParseSize(const std::string& text, int* width, int* height) {
 
 }  // namespace
 
-void ViewRequest::Check() const {
-  if (!ParseScreenType(view)) throw FieldError("view", "unknown view '" + view + "'");
+std::string ViewRequest::Check() const {
+  if (!ParseScreenType(view)) return FieldMessage("view", "unknown view '" + view + "'");
   int width = 0, height = 0;
   if (!size.empty() && !ParseSize(size, &width, &height))
-    throw FieldError("size", "'" + size + "' is not WxH (e.g. 2048x512)");
-  if (!elevation_deg.empty() && elevation_deg.size() != 2) throw FieldError("elevation_deg", "give top and bottom");
+    return FieldMessage("size", "'" + size + "' is not WxH (e.g. 2048x512)");
+  if (!elevation_deg.empty() && elevation_deg.size() != 2) return FieldMessage("elevation_deg", "give top and bottom");
   if (int(distance_mm.has_value()) + int(n.has_value()) + int(infinity) > 1)
-    throw FieldError(n ? "n" : "distance_mm", "give only one of distance_mm, n and infinity");
+    return FieldMessage(n ? "n" : "distance_mm", "give only one of distance_mm, n and infinity");
   if (!infinity) {
-    if (!distance_mm && !n) throw FieldError("distance_mm", "give the object distance (distance_mm or n) or infinity");
+    if (!distance_mm && !n) return FieldMessage("distance_mm", "give the object distance (distance_mm or n) or infinity");
     const auto kind = ParseSurfaceKind(surface);
-    if (!kind || *kind == ObjectSurface::Kind::kInfinity) throw FieldError("surface", "unknown '" + surface + "'");
+    if (!kind || *kind == ObjectSurface::Kind::kInfinity) return FieldMessage("surface", "unknown '" + surface + "'");
     const double distance = distance_mm ? *distance_mm : *n;
-    if (!std::isfinite(distance) || distance <= 0.0) throw FieldError(n ? "n" : "distance_mm", "the object distance must be > 0");
+    if (!std::isfinite(distance) || distance <= 0.0) return FieldMessage(n ? "n" : "distance_mm", "the object distance must be > 0");
   }
   if (!plane_normal.empty()) {
-    if (infinity || surface != "plane") throw FieldError("plane_normal", "only for a plane surface");
+    if (infinity || surface != "plane") return FieldMessage("plane_normal", "only for a plane surface");
     const bool finite = std::all_of(plane_normal.begin(), plane_normal.end(), [](double x) { return std::isfinite(x); });
     if (plane_normal.size() != 3 || !finite || Eigen::Vector3d(plane_normal[0], plane_normal[1], plane_normal[2]).norm() <= 0.0)
-      throw FieldError("plane_normal", "zero or not finite");
+      return FieldMessage("plane_normal", "zero or not finite");
   }
-  if (v0_mm && !std::isfinite(*v0_mm)) throw FieldError("v0_mm", "not finite");
-  if (threads < 0) throw FieldError("threads", "must be >= 0");
+  if (v0_mm && !std::isfinite(*v0_mm)) return FieldMessage("v0_mm", "not finite");
+  if (threads < 0) return FieldMessage("threads", "must be >= 0");
+  return "";
 }
 
 ResolvedView ResolveView(const Sensor& sensor, const ViewRequest& request) {
-  request.Check();
+  if (const std::string why = request.Check(); !why.empty()) throw InputError(why);
   ResolvedView resolved;
   RemapSettings& settings = resolved.settings;
   VirtualScreen& screen = settings.screen;
@@ -69,7 +70,7 @@ ResolvedView ResolveView(const Sensor& sensor, const ViewRequest& request) {
   if (!request.infinity) {
     surface.kind = *ParseSurfaceKind(request.surface);
     surface.distance_mm = request.distance_mm ? *request.distance_mm : *request.n * rim;
-    if (!std::isfinite(surface.distance_mm)) throw FieldError(request.n ? "n" : "distance_mm", "the object distance must be > 0");
+    if (!std::isfinite(surface.distance_mm)) throw InputError(FieldMessage(request.n ? "n" : "distance_mm", "the object distance must be > 0"));
   }
   if (!request.plane_normal.empty())
     surface.plane_normal =
@@ -109,7 +110,7 @@ double ReferenceDistanceMm(const Sensor& sensor, const ObjectSurface& surface) {
 
 double ResolveV0Mm(const std::vector<FieldSample>& field, double reference_distance_mm, const std::optional<double>& given) {
   if (!given) return BestViewpointMm(field, reference_distance_mm);
-  if (!std::isfinite(*given)) throw FieldError("v0_mm", "not finite");
+  if (!std::isfinite(*given)) throw InputError(FieldMessage("v0_mm", "not finite"));
   return *given;
 }
 

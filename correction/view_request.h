@@ -36,8 +36,8 @@ struct ViewRequest {
   int threads = 0;                   // 0: all cores
   bool per_pixel = false;            // every output pixel projected (no interpolated grid)
 
-  // The checks that need no sensor; throws InputError naming the field.
-  void Check() const;
+  // The checks that need no sensor: "" or "field: problem".
+  std::string Check() const;
 };
 
 struct ResolvedView {
