@@ -3,12 +3,11 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "calib/predicted_error.h"
 #include "model/io/atomic_write.h"
 #include "model/input_error.h"
+#include "model/io/json_file.h"
 
 namespace omnical {
 namespace {
@@ -178,12 +177,6 @@ CalibrationRecord ParseCalibrationJson(const std::string& text, const std::strin
   return FromJson(j, name);
 }
 
-CalibrationRecord ReadCalibrationJson(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(InputMessage(path, "", "cannot be read"));
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParseCalibrationJson(text.str(), path);
-}
+CalibrationRecord ReadCalibrationJson(const std::string& path) { return FromJson(ReadJsonFile(path), path); }
 
 }  // namespace omnical
