@@ -15,6 +15,7 @@ omnical_packages=(
   libopencv-dev libopencv-contrib-dev libapriltag-dev
   libgtest-dev libgmock-dev libbenchmark-dev python3
   ffmpeg python3-numpy
+  python3-dev pybind11-dev python3-pytest python3-matplotlib python3-opencv
 )
 
 install_dependencies() {
@@ -33,8 +34,13 @@ install_dependencies() {
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 }
 
+# The Python module is built for Debian's interpreter, the one the python3-* packages above
+# are for (another python3 may come first on PATH, e.g. pyenv's).
+python_args=()
+[ -x /usr/bin/python3 ] && python_args=(-DPython_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3)
+
 configure_and_build() {
-  cmake -S "$omnical_root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "$@"
+  cmake -S "$omnical_root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release "${python_args[@]}" "$@"
   cmake --build "$build_dir" -j "$jobs"
 }
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Fails when a source file includes a header from a layer it may not use (docs/layers.md),
-and when the CLI stops being thin (a subcommand over 150 lines, tools/ over a quarter of
-the library).
+and when a front end stops being thin (a CLI subcommand over 150 lines, the CLI or the
+Python module each over a quarter of the library).
 
 Usage: layers_test.py SOURCE_DIR            check the tree
        layers_test.py SOURCE_DIR --self-test  also check that planted violations are caught
@@ -16,7 +16,8 @@ INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
 # Third-party header prefixes we police (the standard library and system headers pass).
 THIRD_PARTY = {"Eigen": "Eigen", "unsupported": "Eigen", "ceres": "ceres", "boost": "boost", "yaml-cpp": "yaml-cpp",
                "nlohmann": "nlohmann", "opencv2": "opencv2", "apriltag": "apriltag", "CLI": "CLI", "gtest": "gtest",
-               "gmock": "gmock", "benchmark": "benchmark", "glog": "ceres", "gflags": "ceres"}
+               "gmock": "gmock", "benchmark": "benchmark", "glog": "ceres", "gflags": "ceres",
+               "pybind11": "pybind11", "Python.h": "pybind11"}
 
 
 def read_table(root):
@@ -73,14 +74,19 @@ def check(root, layers):
     return problems
 
 
+FRONT_ENDS = ("cli", "python")
+
+
 def front_end_is_thin(root, layers):
-    """The CLI parses, calls, prints: no subcommand file over 150 lines, and tools/ under a
-    quarter of the library's lines (the library layers of the table)."""
+    """The front ends parse, call, print: no CLI subcommand file over 150 lines, and the
+    CLI and the Python module each under a quarter of the library's lines (the library
+    layers of the table)."""
     problems = []
     def lines(path):
         with open(path, errors="replace") as f:
             return sum(1 for _ in f)
-    library = cli = 0
+    library = 0
+    front = {name: 0 for name in FRONT_ENDS}
     for name, directory, _, _ in layers:
         if name == "tests":
             continue
@@ -92,15 +98,16 @@ def front_end_is_thin(root, layers):
                 if layer_of(os.path.relpath(path, root), layers)[0] != name:
                     continue
                 count = lines(path)
-                if name == "cli":
-                    cli += count
-                    if file.startswith("cmd_") and file.endswith(".cc") and count > 150:
+                if name in front:
+                    front[name] += count
+                    if name == "cli" and file.startswith("cmd_") and file.endswith(".cc") and count > 150:
                         problems.append(f"{os.path.relpath(path, root)}: {count} lines (a subcommand stays under 150)")
                 else:
                     library += count
-    if library and cli >= library / 4:
-        problems.append(f"tools/: {cli} lines, not under a quarter of the library's {library}")
-    return problems, cli, library
+    for name, count in front.items():
+        if library and count >= library / 4:
+            problems.append(f"front end {name}: {count} lines, not under a quarter of the library's {library}")
+    return problems, front["cli"], library
 
 
 def self_test(root, layers):

@@ -1,0 +1,8 @@
+#include "tools/python/bindings.h"
+#include "tools/python/py_common.h"
+
+namespace omnical::python {
+
+void BindCorrection(py::module_& /*m*/) {}
+
+}  // namespace omnical::python

@@ -1,0 +1,124 @@
+#include "tools/python/py_common.h"
+
+#include <atomic>
+#include <csignal>
+#include <string>
+
+#include "model/input_error.h"
+
+namespace omnical::python {
+namespace {
+
+// Set by the SIGINT handler while a long call runs; read by every progress callback.
+std::atomic<bool> g_interrupted{false};
+struct sigaction g_python_sigint;  // Python's own handler, chained to
+
+void OnSigint(int signal) {
+  g_interrupted = true;
+  // Python's C handler only records the signal (async-signal-safe); its Python-level
+  // handler (KeyboardInterrupt, or the user's) runs once the call has returned.
+  if (g_python_sigint.sa_handler != SIG_DFL && g_python_sigint.sa_handler != SIG_IGN)
+    g_python_sigint.sa_handler(signal);
+}
+
+bool OnMainThread() {
+  const py::object threading = py::module_::import("threading");
+  return threading.attr("current_thread")().is(threading.attr("main_thread")());
+}
+
+std::string ShapeText(const py::array& array) {
+  std::string text = "(";
+  for (py::ssize_t i = 0; i < array.ndim(); ++i) text += (i ? ", " : "") + std::to_string(array.shape(i));
+  return text + (array.ndim() == 1 ? ",)" : ")");
+}
+
+// While a long call runs on the main thread, SIGINT also sets g_interrupted. Only the
+// main thread gets KeyboardInterrupt; a call from another thread is cancelled through its
+// progress callback alone. Nested calls (a callback calling omnical) keep the outer watch.
+class SigintWatch {
+ public:
+  SigintWatch() : active_(depth_ == 0 && OnMainThread()) {
+    ++depth_;
+    if (!active_) return;
+    g_interrupted = false;
+    struct sigaction ours = {};
+    ours.sa_handler = OnSigint;
+    sigemptyset(&ours.sa_mask);
+    sigaction(SIGINT, &ours, &g_python_sigint);
+  }
+  ~SigintWatch() {
+    --depth_;
+    if (active_) sigaction(SIGINT, &g_python_sigint, nullptr);
+  }
+  bool interrupted() const { return active_ && g_interrupted; }
+
+ private:
+  static inline int depth_ = 0;  // guarded by the GIL
+  bool active_;
+};
+
+}  // namespace
+
+RowsArray RowsOf(const py::handle& object, int columns, const char* name) {
+  const std::string expected = std::string(name) + ": expected an (N, " + std::to_string(columns) + ") array of numbers";
+  py::array array;
+  try {
+    array = py::array::ensure(object);
+  } catch (const py::error_already_set&) {
+  }
+  if (!array) throw InputError(expected + ", got " + std::string(py::str(py::type::of(object).attr("__name__"))));
+  const char kind = array.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u')
+    throw InputError(expected + ", got dtype " + std::string(py::str(array.dtype())));
+  if (array.ndim() != 2 || array.shape(1) != columns) {
+    std::string hint;
+    if (array.ndim() == 1 && array.shape(0) == columns)
+      hint = " (one point: reshape(1, " + std::to_string(columns) + "))";
+    throw InputError(expected + ", got shape " + ShapeText(array) + hint);
+  }
+  // float32, integers and non-contiguous views: one converting copy into C order.
+  return RowsArray::ensure(array);
+}
+
+std::string PathOf(const py::handle& path) {
+  const py::object os = py::module_::import("os");
+  try {
+    return py::str(os.attr("fspath")(path));
+  } catch (const py::error_already_set&) {
+    throw InputError("expected a path (str or os.PathLike), got " +
+                     std::string(py::str(py::type::of(path).attr("__name__"))));
+  }
+}
+
+ProgressCallback ForwardProgress(py::object progress) {
+  if (progress.is_none()) return [](const ProgressUpdate&) { return !g_interrupted.load(); };
+  // Shared so that copies of the callback made without the GIL do not touch the
+  // reference count; released with the GIL held.
+  auto callback = std::shared_ptr<py::object>(new py::object(std::move(progress)), [](py::object* p) {
+    py::gil_scoped_acquire gil;
+    delete p;
+  });
+  return [callback](const ProgressUpdate& update) {
+    if (g_interrupted) return false;
+    py::gil_scoped_acquire gil;
+    const py::object answer = (*callback)(update.stage, update.done, update.total);
+    return answer.is_none() || PyObject_IsTrue(answer.ptr()) == 1;
+  };
+}
+
+void RunReleasedImpl(const std::function<void()>& job) {
+  SigintWatch watch;
+  try {
+    py::gil_scoped_release release;
+    job();
+    return;
+  } catch (const Cancelled&) {
+    if (!watch.interrupted()) throw;  // the callback said stop: omnical.Cancelled
+  }
+  // Python's handler saw the signal too: let it raise (KeyboardInterrupt by default).
+  if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  PyErr_SetNone(PyExc_KeyboardInterrupt);
+  throw py::error_already_set();
+}
+
+}  // namespace omnical::python
