@@ -6,12 +6,15 @@
 #  2. calibrate: calibrates a bundled rendered set from C++ and must reproduce the
 #     installed CLI's calibration.json to 1e-9;
 #  3. remap: builds a parallax-corrected panorama table, checks it against direct
-#     projections (< 0.01 px) and applies it to a rendered image.
+#     projections (< 0.01 px) and applies it to a rendered image;
+#  4. with PYTHON given: the installed Python package imports from the prefix's site
+#     directory (not the build tree) and projects a point as the installed CLI does.
 # Also: only public headers are installed, and all of them compile in one unit.
-# Usage: install_test.sh BUILD_DIR SOURCE_DIR
+# Usage: install_test.sh BUILD_DIR SOURCE_DIR [PYTHON]
 set -euo pipefail
 build_dir=$1
 source_dir=$2
+python=${3:-}
 data=$source_dir/datasets-synthetic
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -76,4 +79,25 @@ build remap
   fail "remap: the example failed"
 test -s "$work/panorama.png" || fail "remap: no panorama written"
 passed=$((passed + 1))
+
+# 4. The Python package, installed under the prefix.
+if [ -n "$python" ]; then
+  module=$(find "$prefix" -name '_omnical*.so' | head -1)
+  [ -n "$module" ] || fail "python: no installed extension module under $prefix"
+  site=$(dirname "$(dirname "$module")")
+  for file in __init__.py _omnical.pyi py.typed; do test -f "$site/omnical/$file" || fail "python: $file not installed"; done
+  printf '400,-150,60\n' >"$work/point.csv"
+  expected=$("$prefix/bin/omnical" project --sensor "$data/sensors/ohte-sph.yaml" --points "$work/point.csv" | tail -1)
+  (cd "$work" && PYTHONPATH="$site" "$python" - "$data/sensors/ohte-sph.yaml" "$expected" "$site") <<'PY' || fail "python: the installed package"
+import sys
+import omnical
+sensor_path, expected, site = sys.argv[1:]
+assert omnical.__file__.startswith(site), omnical.__file__
+pixels, status = omnical.Sensor.load(sensor_path).project([[400.0, -150.0, 60.0]])
+u, v, name = expected.split(",")
+assert omnical.status_name(status[0]) == name, (status, expected)
+assert abs(pixels[0, 0] - float(u)) < 1e-9 and abs(pixels[0, 1] - float(v)) < 1e-9, (pixels, expected)
+PY
+  passed=$((passed + 1))
+fi
 echo "$passed passed, 0 failed"

@@ -2,8 +2,6 @@
 CLI's `project` / `unproject` output and against geometry (a projected point lies on the
 ray of its pixel)."""
 import csv
-import os
-import pickle
 import sys
 import threading
 import time

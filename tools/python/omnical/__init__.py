@@ -20,13 +20,23 @@ from . import _omnical
 from ._omnical import *  # noqa: F401,F403
 from ._omnical import __version__, InputError, Cancelled  # noqa: F401
 
-ProjectionStatus = _enum.IntEnum(
-    "ProjectionStatus", {name.upper(): code for code, name in enumerate(_omnical._STATUS_NAMES)}, module=__name__)
-ProjectionStatus.__doc__ = """Why a point has no pixel (or a pixel no ray): the values of the status arrays.
+class ProjectionStatus(_enum.IntEnum):
+    """Why a point has no pixel (or a pixel no ray): the values of the status arrays that
+    Sensor.project and Sensor.unproject return (compare: status == ProjectionStatus.OK).
+    `status_name()` gives the lower-case names omnical's CSV and JSON files use."""
+    OK = 0
+    OUTSIDE_MIRROR = 1       # the reflection point would lie beyond the mirror rim
+    BEHIND_MIRROR = 2        # the point is on the far side of the mirror surface
+    OCCLUDED_BY_CAMERA = 3   # the ray from the mirror to the point hits the camera body
+    OUTSIDE_IMAGE = 4        # the pixel falls outside the sensor's image
+    MISSES_MIRROR = 5        # (unproject) the lens ray does not head towards the mirror
+    NO_SOLUTION = 6          # the solver did not converge
+    INVALID_INPUT = 7        # NaN or infinite input
 
-OK, OUTSIDE_MIRROR, BEHIND_MIRROR, OCCLUDED_BY_CAMERA, OUTSIDE_IMAGE, MISSES_MIRROR,
-NO_SOLUTION, INVALID_INPUT (NaN or infinite input). `status_name()` gives the lower-case
-names the CSV and JSON files use."""
+
+# The library's own list (model/types.h) decides: a status added there fails here at import.
+if [s.name.lower() for s in ProjectionStatus] != list(_omnical._STATUS_NAMES):
+    raise ImportError(f"omnical: ProjectionStatus differs from the library's {_omnical._STATUS_NAMES}")
 
 
 def status_name(code):
