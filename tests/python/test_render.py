@@ -54,6 +54,7 @@ def aprilgrid_corners():
 def test_scene_properties(scene_file):
     scene = omnical.Scene.load(scene_file)
     assert len(scene) == 2 and scene.view_names == ["front", "side"]
+    assert repr(scene) == f"<omnical.Scene {scene_file}: 2 views, 160x160 px>"
     assert scene.path == str(scene_file)
     assert scene.sensor.image_size == (160, 160) and scene.sensor.profile == "sphere"
     assert scene.formation == {"samples_per_pixel": 4, "noise_sigma": 2.0, "blur_sigma_px": 0.0,
@@ -95,6 +96,7 @@ def test_render_equals_cli_and_geometry(scene_file, tmp_path, cli):
         assert len(view.targets) == len(truth_file["targets"]) == 1
         truth, expected = view.targets[0], truth_file["targets"][0]
         assert (truth.name, truth.type) == (expected["name"], expected["type"])
+        assert truth.spec_path == scene.views[0].targets[0].spec_path
         corners = expected["corners"]
         np.testing.assert_array_equal(truth.ids, [c["id"] for c in corners])
         # The JSON holds doubles as shortest round-trip text: equal to the last bit.

@@ -54,7 +54,8 @@ py::array_t<double> Column(size_t rows, Value&& value) {
 // A profile table as profile.csv holds it: (N, 3) radius_mm, sag_mm, slope.
 py::array_t<double> ProfileArray(const ProfileTable& table) {
   Eigen::Matrix3Xd rows(3, table.radius_mm.size());
-  for (size_t i = 0; i < table.radius_mm.size(); ++i) rows.col(i) << table.radius_mm[i], table.sag_mm[i], table.slope[i];
+  for (size_t i = 0; i < table.radius_mm.size(); ++i)
+    rows.col(i) << table.radius_mm[i], table.sag_mm[i], table.slope[i];
   return RowsArrayOf<3>(std::move(rows));
 }
 
@@ -136,7 +137,9 @@ void BindScene(py::module_& m) {
       .def_readonly("spec_path", &PlacedTarget::spec_path, "Its Kalibr-style spec file.")
       .def_property_readonly(
           "camera_from_target",
-          [](const PlacedTarget& t) { return PoseArray(t.camera_from_target_rotation, t.camera_from_target_translation_mm); },
+          [](const PlacedTarget& t) {
+            return PoseArray(t.camera_from_target_rotation, t.camera_from_target_translation_mm);
+          },
           "4x4 pose: point_in_camera_mm = (camera_from_target @ [point_in_target_mm, 1])[:3].")
       .def_property_readonly(
           "corner_ids",
@@ -150,7 +153,8 @@ void BindScene(py::module_& m) {
           "corner_points_mm",
           [](const PlacedTarget& t) {
             Eigen::Matrix3Xd points(3, t.target->corners().size());
-            for (size_t i = 0; i < t.target->corners().size(); ++i) points.col(i) = t.target->corners()[i].point_in_target;
+            for (size_t i = 0; i < t.target->corners().size(); ++i)
+              points.col(i) = t.target->corners()[i].point_in_target;
             return RowsArrayOf<3>(std::move(points));
           },
           "(N, 3) float64: the corners in the board frame (mm, z = 0), in corner_ids' order.");
@@ -158,17 +162,15 @@ void BindScene(py::module_& m) {
       .def_readonly("name", &SceneView::name, "The view's name (its files are <name>.png and <name>.json).")
       .def_readonly("targets", &SceneView::targets, "The targets placed in this view (list of SceneTarget).");
 
-  py::class_<Scene, std::shared_ptr<Scene>>(m, "Scene", R"(A synthetic scene for render: a sensor, planar targets placed around it per
+  py::class_<Scene, std::shared_ptr<Scene>>(
+      m, "Scene", R"(A synthetic scene for render: a sensor, planar targets placed around it per
 view, an environment and the image formation settings (docs/file-formats.md "Scene file").)")
       .def_static(
-          "load",
-          [](const py::object& path) {
-            const std::string file = PathOf(path);
-            return std::make_shared<Scene>(LoadSceneYaml(file));
-          },
-          "path"_a, "Reads a scene file (YAML), its sensor and target specs. Raises InputError 'scene.yaml: field: problem'.")
+          "load", [](const py::object& path) { return std::make_shared<Scene>(LoadSceneYaml(PathOf(path))); }, "path"_a,
+          "Reads a scene file (YAML), its sensor and target specs. Raises InputError 'scene.yaml: field: problem'.")
       .def_readonly("path", &Scene::path, "The scene file it was loaded from.")
-      .def_property_readonly("sensor", [](const Scene& s) { return *s.sensor; }, "The scene's Sensor (a copy).")
+      .def_property_readonly(
+          "sensor", [](const Scene& s) { return *s.sensor; }, "The scene's Sensor (a copy).")
       .def_readonly("views", &Scene::views, "The views (list of SceneView), random_views included, in render order.")
       .def_property_readonly(
           "view_names",
@@ -186,7 +188,8 @@ view, an environment and the image formation settings (docs/file-formats.md "Sce
                             "blur_sigma_px"_a = f.blur_sigma_px, "vignetting"_a = f.vignetting, "seed"_a = f.seed);
           },
           "The scene's render section: samples_per_pixel, noise_sigma, blur_sigma_px, vignetting, seed.")
-      .def("__len__", [](const Scene& s) { return s.views.size(); }, "The number of views.")
+      .def(
+          "__len__", [](const Scene& s) { return s.views.size(); }, "The number of views.")
       .def("__repr__", [](const Scene& s) {
         return "<omnical.Scene " + s.path + ": " + std::to_string(s.views.size()) + " views, " +
                std::to_string(s.sensor->image_width_px()) + "x" + std::to_string(s.sensor->image_height_px()) + " px>";
@@ -255,7 +258,8 @@ DesignOdeResult DesignOde(const py::object& spec_path, const std::optional<std::
     if (any_field) throw InputError("spec: give a design spec file or law= and the design's fields, not both");
     spec = LoadOdeDesignSpec(PathOf(spec_path));
   } else {
-    if (!law) throw InputError("spec: give a design spec file, or law= (linear, logpolar or table) and the design's fields");
+    if (!law)
+      throw InputError("spec: give a design spec file, or law= (linear, logpolar or table) and the design's fields");
     if (*law != "linear" && *law != "logpolar" && *law != "table")
       throw InputError("law: must be linear, logpolar or table, not '" + *law + "'");
     spec.law.kind = *law == "linear"     ? ImagingLaw::Kind::kLinear
@@ -286,18 +290,25 @@ void SaveOde(const DesignOdeResult& r, const py::object& out_dir) {
 }
 
 void BindDesignOde(py::module_& m) {
-  py::class_<DesignOdeResult> result(m, "DesignOdeResult", R"(A mirror from Gächter's reflection ODE (model/design/design_ode_job.h):
+  py::class_<DesignOdeResult> result(m, "DesignOdeResult",
+                                     R"(A mirror from Gächter's reflection ODE (model/design/design_ode_job.h):
 the profile, the designed sensor, its field of view and the law checked by tracing rays
 through that sensor on cylinders at 0.5, 0.75, 1, 1.5 and 2 x the reference distance.)");
-  result.def_readonly("sensor", &DesignOdeResult::sensor, "The designed Sensor (tabulated mirror, pinhole lens; its mirror.table is profile.csv).")
-      .def_property_readonly("profile_table", [](const DesignOdeResult& r) { return ProfileArray(r.profile); },
-                             "(N, 3) float64 as profile.csv: radius_mm, sag_mm (from the vertex), slope dz/dx.")
-      .def_property_readonly("fov_deg", [](const DesignOdeResult& r) { return r.design.phi1_deg - r.design.phi0_deg; },
-                             "Vertical field of view phi1 - phi0 (deg).")
-      .def_property_readonly("ended_at_rim", [](const DesignOdeResult& r) { return r.design.ended_at_rim; },
-                             "True when the field ends at the rim limit t1 (inside rho1).")
-      .def_property_readonly("ode_steps", [](const DesignOdeResult& r) { return r.design.ode_steps; },
-                             "Steps the adaptive ODE solver took.")
+  result
+      .def_readonly("sensor", &DesignOdeResult::sensor,
+                    "The designed Sensor (tabulated mirror, pinhole lens; its mirror.table is profile.csv).")
+      .def_property_readonly(
+          "profile_table", [](const DesignOdeResult& r) { return ProfileArray(r.profile); },
+          "(N, 3) float64 as profile.csv: radius_mm, sag_mm (from the vertex), slope dz/dx.")
+      .def_property_readonly(
+          "fov_deg", [](const DesignOdeResult& r) { return r.design.phi1_deg - r.design.phi0_deg; },
+          "Vertical field of view phi1 - phi0 (deg).")
+      .def_property_readonly(
+          "ended_at_rim", [](const DesignOdeResult& r) { return r.design.ended_at_rim; },
+          "True when the field ends at the rim limit t1 (inside rho1).")
+      .def_property_readonly(
+          "ode_steps", [](const DesignOdeResult& r) { return r.design.ode_steps; },
+          "Steps the adaptive ODE solver took.")
       .def_readonly("vertex_height_mm", &DesignOdeResult::vertex_height_mm, "F0: image plane to mirror vertex (mm).")
       .def_readonly("m_mm", &DesignOdeResult::m_mm, "Lens to mirror vertex, F0 - f (mm).")
       .def_readonly("pixel_pitch_mm", &DesignOdeResult::pixel_pitch_mm, "The designed sensor's pixel pitch (mm).")
@@ -305,7 +316,9 @@ through that sensor on cylinders at 0.5, 0.75, 1, 1.5 and 2 x the reference dist
                     "max |ratio - 1| at the reference distance (inf where a ray missed).")
       .def_property_readonly(
           "law_ratio_distance_mm",
-          [](const DesignOdeResult& r) { return Column(r.law_ratio.size(), [&](size_t i) { return r.law_ratio[i].distance_mm; }); },
+          [](const DesignOdeResult& r) {
+            return Column(r.law_ratio.size(), [&](size_t i) { return r.law_ratio[i].distance_mm; });
+          },
           "(K,) the cylinder radii the law was traced at (mm); index 2 is the reference distance.")
       .def_property_readonly(
           "law_ratio_rho_mm",
@@ -314,7 +327,8 @@ through that sensor on cylinders at 0.5, 0.75, 1, 1.5 and 2 x the reference dist
       .def_property_readonly(
           "law_ratio",
           [](const DesignOdeResult& r) {
-            py::array_t<double> ratio({static_cast<py::ssize_t>(r.law_ratio.size()), static_cast<py::ssize_t>(r.reference_curve().ratio.size())});
+            py::array_t<double> ratio({static_cast<py::ssize_t>(r.law_ratio.size()),
+                                       static_cast<py::ssize_t>(r.reference_curve().ratio.size())});
             auto out = ratio.mutable_unchecked<2>();
             for (size_t k = 0; k < r.law_ratio.size(); ++k)
               for (size_t i = 0; i < r.law_ratio[k].ratio.size(); ++i) out(k, i) = r.law_ratio[k].ratio[i];
@@ -329,7 +343,8 @@ design.json and the figures (law_ratio.png, profile.png, profile_drawing.svg/.pn
       {"phi1_deg", &OdeDesign::phi1_deg, "Elevation seen at the field's end (deg)."},
       {"t_start_mm", &OdeDesign::t_start_mm, "Mirror radius imaged at rho0 (mm)."},
       {"t_end_mm", &OdeDesign::t_end_mm, "Mirror radius at the field's end: the designed mirror's rim (mm)."},
-      {"rho_end_mm", &OdeDesign::rho_end_mm, "Image radius of the field's end: rho1, or the rim's image before it (mm)."}};
+      {"rho_end_mm", &OdeDesign::rho_end_mm,
+       "Image radius of the field's end: rho1, or the rim's image before it (mm)."}};
   for (const auto& [name, field, doc] : design_numbers)
     result.def_property_readonly(name, [field = field](const DesignOdeResult& r) { return r.design.*field; }, doc);
 
@@ -378,21 +393,26 @@ measured through its own model (model/design/mirror_design_fit.h).)")
       .def_readonly("rim_h_px", &CharacteristicReport::rim_h_px, "Image radius of the rim (px).")
       .def_readonly("rim_omega_deg", &CharacteristicReport::rim_omega_deg, "Omega at the rim (deg).")
       .def_readonly("rim_theta_deg", &CharacteristicReport::rim_theta_deg, "Theta at the rim (deg).")
-      .def_readonly("equidistant_max_px", &CharacteristicReport::equidistant_max_px, "max |h - h_law| (px), equidistant.")
+      .def_readonly("equidistant_max_px", &CharacteristicReport::equidistant_max_px,
+                    "max |h - h_law| (px), equidistant.")
       .def_readonly("constant_aspect_max_px", &CharacteristicReport::constant_aspect_max_px,
                     "max |h - h_law| (px), constant aspect ratio.")
       .def_readonly("equal_area_max_px", &CharacteristicReport::equal_area_max_px, "max |h - h_law| (px), equal area.")
-      .def_readonly("viewpoint_spread_mm", &CharacteristicReport::viewpoint_spread_mm, "max - min z_v over the mirror (mm).");
+      .def_readonly("viewpoint_spread_mm", &CharacteristicReport::viewpoint_spread_mm,
+                    "max - min z_v over the mirror (mm).");
 
   py::class_<DesignFitResult>(m, "DesignFitResult", R"(Ohte & Tsuzuki's design by parameters (Table 1) solved with Ceres
 (model/design/design_fit_job.h): the normalised parameters, the sensor in mm and the laws it achieves.)")
       .def_readonly("sensor", &DesignFitResult::sensor, "The designed axial Sensor (mm).")
-      .def_property_readonly("profile", [](const DesignFitResult& r) { return ProfileFamilyName(r.spec.family); },
-                             "The profile family: sphere, polynomial or hyperboloid.")
-      .def_property_readonly("characteristic", [](const DesignFitResult& r) { return CharacteristicName(r.spec.characteristic); },
-                             "The characteristic fitted: none, equidistant, svp, aspect or area.")
-      .def_property_readonly("law", [](const DesignFitResult& r) { return CharacteristicName(r.law); },
-                             "The law the curves are measured against.")
+      .def_property_readonly(
+          "profile", [](const DesignFitResult& r) { return ProfileFamilyName(r.spec.family); },
+          "The profile family: sphere, polynomial or hyperboloid.")
+      .def_property_readonly(
+          "characteristic", [](const DesignFitResult& r) { return CharacteristicName(r.spec.characteristic); },
+          "The characteristic fitted: none, equidistant, svp, aspect or area.")
+      .def_property_readonly(
+          "law", [](const DesignFitResult& r) { return CharacteristicName(r.law); },
+          "The law the curves are measured against.")
       .def_property_readonly(
           "parameters",
           [](const DesignFitResult& r) {
@@ -403,17 +423,23 @@ measured through its own model (model/design/mirror_design_fit.h).)")
           "Normalised parameters (mirror radius 1) with Table 1's names: sphere A, m; hyperboloid A, B, m; "
           "polynomial c1..cn, m.")
       .def_readonly("rim_radius_mm", &DesignFitResult::rim_radius_mm, "The rim radius M the design is scaled by (mm).")
-      .def_property_readonly("profile_table", [](const DesignFitResult& r) { return ProfileArray(r.profile); },
-                             "(N, 3) float64 as profile.csv: radius_mm, sag_mm, slope.")
-      .def_readonly("achieved", &DesignFitResult::achieved, "The laws the designed sensor achieves (CharacteristicReport).")
+      .def_property_readonly(
+          "profile_table", [](const DesignFitResult& r) { return ProfileArray(r.profile); },
+          "(N, 3) float64 as profile.csv: radius_mm, sag_mm, slope.")
+      .def_readonly("achieved", &DesignFitResult::achieved,
+                    "The laws the designed sensor achieves (CharacteristicReport).")
       .def_readonly("compared", &DesignFitResult::compared, "Those of the compared sensor, or None.")
-      .def_property_readonly("free_parameters", [](const DesignFitResult& r) { return r.design.free_params; },
-                             "Parameters left free after the two rim targets.")
-      .def_property_readonly("iterations", [](const DesignFitResult& r) { return r.design.iterations; }, "Ceres iterations.")
-      .def_property_readonly("final_cost", [](const DesignFitResult& r) { return r.design.final_cost; },
-                             "Ceres' final cost (1/2 sum of squared normalised residuals).")
-      .def_property_readonly("solver_report", [](const DesignFitResult& r) { return r.design.solver_report; },
-                             "Ceres' brief report ('closed form' for a sphere).")
+      .def_property_readonly(
+          "free_parameters", [](const DesignFitResult& r) { return r.design.free_params; },
+          "Parameters left free after the two rim targets.")
+      .def_property_readonly(
+          "iterations", [](const DesignFitResult& r) { return r.design.iterations; }, "Ceres iterations.")
+      .def_property_readonly(
+          "final_cost", [](const DesignFitResult& r) { return r.design.final_cost; },
+          "Ceres' final cost (1/2 sum of squared normalised residuals).")
+      .def_property_readonly(
+          "solver_report", [](const DesignFitResult& r) { return r.design.solver_report; },
+          "Ceres' brief report ('closed form' for a sphere).")
       .def(
           "save",
           [](const DesignFitResult& r, const py::object& out_dir) {
@@ -453,7 +479,8 @@ design.json and the figures (characteristic.png, profile_drawing.svg/.png).)");
                                         ImageCharacteristic::kSingleViewpoint, ImageCharacteristic::kConstantAspect,
                                         ImageCharacteristic::kEqualArea})
             if (name == CharacteristicName(c)) o.spec.characteristic = c, known = true;
-          if (!known) throw InputError("characteristic: must be none, equidistant, svp, aspect or area, not '" + name + "'");
+          if (!known)
+            throw InputError("characteristic: must be none, equidistant, svp, aspect or area, not '" + name + "'");
         }
         o.rim_radius_mm = rim_radius_mm;
         o.image_size_px = image_size_px;
@@ -525,39 +552,53 @@ py::dict CharacteristicCurves(const CharacterizeResult& r) {
 }
 
 void BindCharacterize(py::module_& m) {
-  py::class_<PyCharacterization> result(m, "CharacterizeResult", R"(The seed paper's evaluation of a sensor (Ohte & Tsuzuki Secs. 2-3;
+  py::class_<PyCharacterization> result(m, "CharacterizeResult",
+                                        R"(The seed paper's evaluation of a sensor (Ohte & Tsuzuki Secs. 2-3;
 model/design/characterize.h): image-forming characteristics, viewpoints, virtual images,
 blur and depth of field over the mirror.)");
-  result.def_property_readonly("curves", [](const PyCharacterization& c) { return CharacteristicCurves(c.result); },
-                             "Dict of (samples,) float64 arrays, the columns of characteristics.csv (same names).")
+  result
+      .def_property_readonly(
+          "curves", [](const PyCharacterization& c) { return CharacteristicCurves(c.result); },
+          "Dict of (samples,) float64 arrays, the columns of characteristics.csv (same names).")
       .def_property_readonly(
           "azimuth_curves",
           [](const PyCharacterization& c) {
             py::list curves;
             for (const auto& curve : c.result.azimuth_curves) {
               Eigen::Matrix3Xd rows(3, curve.size());
-              for (size_t i = 0; i < curve.size(); ++i) rows.col(i) << curve[i].x_mm, curve[i].omega_rad * kDeg, curve[i].h_px;
+              for (size_t i = 0; i < curve.size(); ++i)
+                rows.col(i) << curve[i].x_mm, curve[i].omega_rad * kDeg, curve[i].h_px;
               curves.append(RowsArrayOf<3>(std::move(rows)));
             }
             return curves;
           },
           "Tilted or decentred sensor: (N, 3) x_mm, omega_deg, h_px along azimuths 0, 90, 180, 270 deg; else [].")
-      .def_property_readonly("profile", [](const PyCharacterization& c) { return c.result.profile_name; }, "Mirror profile.")
-      .def_property_readonly("lens", [](const PyCharacterization& c) { return c.result.lens_name; }, "Lens model.")
-      .def_property_readonly("axial", [](const PyCharacterization& c) { return c.result.axial; },
-                             "False: analysed as the aligned counterpart (azimuth_curves exact).")
-      .def_property_readonly("samples", [](const PyCharacterization& c) { return c.result.samples; }, "Mirror radii analysed.")
-      .def_property_readonly("lens_focal_mm", [](const PyCharacterization& c) { return c.result.lens.lens_focal_mm; },
-                             "Lens focal length of the blur analysis (mm).")
-      .def_property_readonly("f_number", [](const PyCharacterization& c) { return c.result.lens.f_number; }, "f-number.")
-      .def_property_readonly("focus_searched", [](const PyCharacterization& c) { return c.result.focus_searched; },
-                             "True when L0 was searched (focus_mm not given).")
-      .def_property_readonly("viewpoint_spread_mm", [](const PyCharacterization& c) { return c.result.viewpoint_spread_mm(); },
-                             "z_v range (mm): 0 for a single viewpoint.")
-      .def_property_readonly("rim_omega_deg", [](const PyCharacterization& c) { return c.result.rim_omega_deg(); },
-                             "Omega at the rim (deg).")
-      .def_property_readonly("rim_theta_deg", [](const PyCharacterization& c) { return c.result.rim_theta_deg(); },
-                             "Theta at the rim (deg).")
+      .def_property_readonly(
+          "profile", [](const PyCharacterization& c) { return c.result.profile_name; }, "Mirror profile.")
+      .def_property_readonly(
+          "lens", [](const PyCharacterization& c) { return c.result.lens_name; }, "Lens model.")
+      .def_property_readonly(
+          "axial", [](const PyCharacterization& c) { return c.result.axial; },
+          "False: analysed as the aligned counterpart (azimuth_curves exact).")
+      .def_property_readonly(
+          "samples", [](const PyCharacterization& c) { return c.result.samples; }, "Mirror radii analysed.")
+      .def_property_readonly(
+          "lens_focal_mm", [](const PyCharacterization& c) { return c.result.lens.lens_focal_mm; },
+          "Lens focal length of the blur analysis (mm).")
+      .def_property_readonly(
+          "f_number", [](const PyCharacterization& c) { return c.result.lens.f_number; }, "f-number.")
+      .def_property_readonly(
+          "focus_searched", [](const PyCharacterization& c) { return c.result.focus_searched; },
+          "True when L0 was searched (focus_mm not given).")
+      .def_property_readonly(
+          "viewpoint_spread_mm", [](const PyCharacterization& c) { return c.result.viewpoint_spread_mm(); },
+          "z_v range (mm): 0 for a single viewpoint.")
+      .def_property_readonly(
+          "rim_omega_deg", [](const PyCharacterization& c) { return c.result.rim_omega_deg(); },
+          "Omega at the rim (deg).")
+      .def_property_readonly(
+          "rim_theta_deg", [](const PyCharacterization& c) { return c.result.rim_theta_deg(); },
+          "Theta at the rim (deg).")
       .def(
           "save",
           [](const PyCharacterization& c, const py::object& out_dir) {
@@ -583,7 +624,8 @@ sensor file characterize was given, or "sensor" for a Sensor object) and fig04..
       {"viewpoint_max_mm", &CharacterizeResult::viewpoint_max_mm, "Highest viewpoint z_v (mm)."},
       {"caustic_radial_mm", &CharacterizeResult::caustic_radial_mm, "Caustic's radial extent (mm)."},
       {"caustic_axial_mm", &CharacterizeResult::caustic_axial_mm, "Caustic's axial extent (mm)."},
-      {"max_astigmatism_mm", &CharacterizeResult::max_astigmatism_mm, "max |L_t - L_s| of the far virtual images (mm)."},
+      {"max_astigmatism_mm", &CharacterizeResult::max_astigmatism_mm,
+       "max |L_t - L_s| of the far virtual images (mm)."},
       {"worst_blur_px", &CharacterizeResult::worst_blur_px, "Largest blur spot (px)."},
       {"dh_domega_min", &CharacterizeResult::dh_domega_min, "Smallest dh/dOmega (px/deg)."},
       {"dh_domega_max", &CharacterizeResult::dh_domega_max, "Largest dh/dOmega (px/deg)."},
