@@ -75,21 +75,21 @@ py::array_t<float> TableView(const std::vector<float>& values, int width, int he
 // --- view requests ---------------------------------------------------------------------
 // Every ViewRequest field is a keyword of the same name (so the library's "field: problem"
 // messages name the keyword); the list is shared by remap() and Unwarper.from_view().
-#define OMNICAL_VIEW_PARAMS                                                                                              \
-  const std::string &view, const py::object &size, double azimuth0_deg,                                                \
-      const std::optional<std::vector<double>> &elevation_deg, double pan_deg, double tilt_deg, double roll_deg,       \
-      double hfov_deg, std::optional<double> omega_max_deg, std::optional<double> distance_mm, std::optional<double> n, \
-      bool infinity, const std::string &surface, const std::optional<std::vector<double>> &plane_normal,               \
-      std::optional<double> v0_mm, int threads, bool per_pixel
-#define OMNICAL_VIEW_FIELDS                                                                                         \
+#define OMNICAL_VIEW_PARAMS                                                                                     \
+  const std::string &view, const py::object &size, double azimuth0_deg,                                         \
+      const std::optional<std::vector<double>>&elevation_deg, double pan_deg, double tilt_deg, double roll_deg, \
+      double hfov_deg, std::optional<double> omega_max_deg, std::optional<double> distance_mm,                  \
+      std::optional<double> n, bool infinity, const std::string &surface,                                       \
+      const std::optional<std::vector<double>>&plane_normal, std::optional<double> v0_mm, int threads, bool per_pixel
+#define OMNICAL_VIEW_FIELDS                                                                                      \
   view, size, azimuth0_deg, elevation_deg, pan_deg, tilt_deg, roll_deg, hfov_deg, omega_max_deg, distance_mm, n, \
       infinity, surface, plane_normal, v0_mm, threads, per_pixel
-#define OMNICAL_VIEW_ARGS                                                                                            \
-  "view"_a = "panorama", py::kw_only(), "size"_a = py::none(), "azimuth0_deg"_a = 180.0,                           \
-      "elevation_deg"_a = py::none(), "pan_deg"_a = 0.0, "tilt_deg"_a = 0.0, "roll_deg"_a = 0.0, "hfov_deg"_a = 60.0, \
-      "omega_max_deg"_a = py::none(), "distance_mm"_a = py::none(), "n"_a = py::none(), "infinity"_a = false,       \
-      "surface"_a = "sphere", "plane_normal"_a = py::none(), "v0_mm"_a = py::none(), "threads"_a = 0,              \
-      "per_pixel"_a = false
+#define OMNICAL_VIEW_ARGS                                                                                         \
+  "view"_a = "panorama", py::kw_only(), "size"_a = py::none(), "azimuth0_deg"_a = 180.0,                          \
+  "elevation_deg"_a = py::none(), "pan_deg"_a = 0.0, "tilt_deg"_a = 0.0, "roll_deg"_a = 0.0, "hfov_deg"_a = 60.0, \
+  "omega_max_deg"_a = py::none(), "distance_mm"_a = py::none(), "n"_a = py::none(), "infinity"_a = false,         \
+  "surface"_a = "sphere", "plane_normal"_a = py::none(), "v0_mm"_a = py::none(), "threads"_a = 0,                 \
+  "per_pixel"_a = false
 
 // "WxH" as given, or (W, H).
 std::string SizeText(const py::object& size) {
@@ -118,7 +118,8 @@ ViewRequest ViewOf(OMNICAL_VIEW_PARAMS) {
 py::dict SettingsOf(const RemapSettings& settings) {
   const VirtualScreen& s = settings.screen;
   const ObjectSurface& o = settings.surface;
-  py::dict d("view"_a = ScreenTypeName(s.type), "size"_a = std::to_string(s.width_px) + "x" + std::to_string(s.height_px));
+  py::dict d("view"_a = ScreenTypeName(s.type),
+             "size"_a = std::to_string(s.width_px) + "x" + std::to_string(s.height_px));
   if (s.type == VirtualScreen::Type::kPanorama || s.type == VirtualScreen::Type::kLonLat) {
     d["azimuth0_deg"] = s.azimuth0_deg;
     d["elevation_deg"] = py::make_tuple(s.elevation_top_deg, s.elevation_bottom_deg);
@@ -131,7 +132,8 @@ py::dict SettingsOf(const RemapSettings& settings) {
     d["infinity"] = true;
   } else {
     d["distance_mm"] = o.distance_mm, d["surface"] = SurfaceKindName(o.kind);
-    if (o.kind == ObjectSurface::Kind::kPlane) d["plane_normal"] = py::make_tuple(o.plane_normal.x(), o.plane_normal.y(), o.plane_normal.z());
+    if (o.kind == ObjectSurface::Kind::kPlane)
+      d["plane_normal"] = py::make_tuple(o.plane_normal.x(), o.plane_normal.y(), o.plane_normal.z());
   }
   d["v0_mm"] = settings.v0_mm, d["threads"] = settings.threads, d["per_pixel"] = !settings.allow_shortcuts;
   return d;
@@ -164,7 +166,8 @@ std::vector<MapFormat> FormatsOf(const py::object& formats) {
   return parsed;
 }
 
-void SaveRemap(const PyRemap& remap, const py::object& out_dir, const py::object& formats, const py::object& sensor_path) {
+void SaveRemap(const PyRemap& remap, const py::object& out_dir, const py::object& formats,
+               const py::object& sensor_path) {
   const std::string dir = PathOf(out_dir);
   const std::vector<MapFormat> parsed = FormatsOf(formats);
   const SensorSource source = SourceFor(sensor_path, remap.sensor);
@@ -213,7 +216,8 @@ Unwarper UnwarperOf(const py::object& maps, const py::object& image, Interpolati
     const RemapResult& result = maps.cast<const PyRemap&>().result;
     return Unwarper(result.table, result.sensor_width_px, result.sensor_height_px, interpolation);
   }
-  if (py::isinstance<py::str>(maps) || py::hasattr(maps, "__fspath__")) return Unwarper::FromMaps(PathOf(maps), interpolation);
+  if (py::isinstance<py::str>(maps) || py::hasattr(maps, "__fspath__"))
+    return Unwarper::FromMaps(PathOf(maps), interpolation);
   const cv::Mat frame = MatOf(image, "image");  // a bare table fits any image of its sensor's size
   return Unwarper(TableOf(maps), frame.cols, frame.rows, interpolation);
 }
@@ -283,32 +287,52 @@ py::array_t<double> PointRows(const std::vector<Point>& points) {
 
 void BindCorrection(py::module_& m) {
   // remap ------------------------------------------------------------------------------
-  py::class_<PyRemap>(m, "RemapResult", R"(A remap table from omnical.remap(): for every output pixel the omni-image pixel to
+  py::class_<PyRemap>(m, "RemapResult",
+                      R"(A remap table from omnical.remap(): for every output pixel the omni-image pixel to
 sample, exact for objects on the chosen surface (what `omnical remap` computes).)")
       .def_property_readonly(
-          "map_x", [](const py::object& self) { const RemapTable& t = self.cast<const PyRemap&>().result.table; return TableView(t.map_x, t.width, t.height, self); },
+          "map_x",
+          [](const py::object& self) {
+            const RemapTable& t = self.cast<const PyRemap&>().result.table;
+            return TableView(t.map_x, t.width, t.height, self);
+          },
           "Omni-image column to sample, float32 (H, W), -1 where the output pixel sees no mirror: "
           "cv2.remap(image, map_x, map_y, cv2.INTER_LINEAR). A view of the result's table.")
       .def_property_readonly(
-          "map_y", [](const py::object& self) { const RemapTable& t = self.cast<const PyRemap&>().result.table; return TableView(t.map_y, t.width, t.height, self); },
+          "map_y",
+          [](const py::object& self) {
+            const RemapTable& t = self.cast<const PyRemap&>().result.table;
+            return TableView(t.map_y, t.width, t.height, self);
+          },
           "Omni-image row to sample, float32 (H, W), -1 where the output pixel sees no mirror.")
-      .def_property_readonly("size", [](const PyRemap& r) { return py::make_tuple(r.result.table.width, r.result.table.height); },
-                             "(width, height) of the output, px.")
-      .def_property_readonly("exactness_px", [](const PyRemap& r) { return r.result.exactness_px; },
-                             "Largest difference between table entries and fresh exact projections of their object points "
-                             "(4000 random output pixels), px.")
-      .def_property_readonly("valid_fraction", [](const PyRemap& r) { return r.result.valid_fraction; },
-                             "Fraction of the output pixels that see the mirror.")
-      .def_property_readonly("v0_mm", [](const PyRemap& r) { return r.result.settings.v0_mm; },
-                             "The viewpoint V0 (z on the mirror axis, mm, mirror frame).")
-      .def_property_readonly("v0_searched", [](const PyRemap& r) { return r.result.v0_searched; },
-                             "True when V0 was chosen (least worst error at the distance), not given.")
-      .def_property_readonly("method", [](const PyRemap& r) {
+      .def_property_readonly(
+          "size", [](const PyRemap& r) { return py::make_tuple(r.result.table.width, r.result.table.height); },
+          "(width, height) of the output, px.")
+      .def_property_readonly(
+          "exactness_px", [](const PyRemap& r) { return r.result.exactness_px; },
+          "Largest difference between table entries and fresh exact projections of their object points "
+          "(4000 random output pixels), px.")
+      .def_property_readonly(
+          "valid_fraction", [](const PyRemap& r) { return r.result.valid_fraction; },
+          "Fraction of the output pixels that see the mirror.")
+      .def_property_readonly(
+          "v0_mm", [](const PyRemap& r) { return r.result.settings.v0_mm; },
+          "The viewpoint V0 (z on the mirror axis, mm, mirror frame).")
+      .def_property_readonly(
+          "v0_searched", [](const PyRemap& r) { return r.result.v0_searched; },
+          "True when V0 was chosen (least worst error at the distance), not given.")
+      .def_property_readonly(
+          "method",
+          [](const PyRemap& r) {
             const RemapTable& t = r.result.table;
-            return t.used_axial_symmetry ? "axial symmetry" : t.interpolation_step_px > 0 ? "interpolated grid" : "per pixel"; },
+            return t.used_axial_symmetry         ? "axial symmetry"
+                   : t.interpolation_step_px > 0 ? "interpolated grid"
+                                                 : "per pixel";
+          },
           "How the table was built: 'axial symmetry', 'interpolated grid' (< 0.01 px) or 'per pixel'.")
-      .def_property_readonly("generation_seconds", [](const PyRemap& r) { return r.result.generation_seconds; },
-                             "Time spent building the table, s.")
+      .def_property_readonly(
+          "generation_seconds", [](const PyRemap& r) { return r.result.generation_seconds; },
+          "Time spent building the table, s.")
       .def_property_readonly(
           "error_at_other_distances",
           [](const PyRemap& r) {
@@ -317,11 +341,13 @@ sample, exact for objects on the chosen surface (what `omnical remap` computes).
               rows.append(py::make_tuple(e.n, e.distance_mm, e.stats.max_px, e.stats.rms_px, e.stats.samples));
             return rows;
           },
-          "How wrong the table is for objects elsewhere: [(n, distance_mm, max_px, rms_px, samples), ...] at n = 1.5, 2, "
+          "How wrong the table is for objects elsewhere: [(n, distance_mm, max_px, rms_px, samples), ...] at n = 1.5, "
+          "2, "
           "3, 5, 7, 10, 20, 40, 100 rim radii and inf (infinity); output px, as maps.json has them.")
-      .def_property_readonly("settings", [](const PyRemap& r) { return SettingsOf(r.result.settings); },
-                             "The resolved view as remap() keywords (defaults filled in): remap(sensor, **settings) "
-                             "makes the same table.")
+      .def_property_readonly(
+          "settings", [](const PyRemap& r) { return SettingsOf(r.result.settings); },
+          "The resolved view as remap() keywords (defaults filled in): remap(sensor, **settings) "
+          "makes the same table.")
       .def("save", &SaveRemap, "out_dir"_a, "formats"_a = py::make_tuple("opencv"), "sensor_path"_a = py::none(),
            R"(Writes what `omnical remap --out OUT_DIR --format ...` writes: the table in each of
 `formats` ("opencv": maps.yml.gz + maps_fixed.yml.gz, "ffmpeg": xmap.pgm + ymap.pgm,
@@ -357,14 +383,17 @@ Returns a RemapResult; InputError names the keyword ("size: '12' is not WxH ..."
           [](const py::object& maps_dir, const std::string& interpolation, const py::object& sensor) {
             if (sensor.is_none()) return Unwarper::FromMaps(PathOf(maps_dir), InterpolationOf(interpolation));
             const SensorArgument given(sensor);
-            return Unwarper::FromMaps(PathOf(maps_dir), InterpolationOf(interpolation), &given.sensor(), given.source().file);
+            return Unwarper::FromMaps(PathOf(maps_dir), InterpolationOf(interpolation), &given.sensor(),
+                                      given.source().file);
           },
           "maps_dir"_a, py::kw_only(), "interpolation"_a = "linear", "sensor"_a = py::none(),
-          "From a directory written by remap (maps.json + maps.yml.gz). `sensor`, when given, must have the maps' image "
+          "From a directory written by remap (maps.json + maps.yml.gz). `sensor`, when given, must have the maps' "
+          "image "
           "size. interpolation: nearest, linear or cubic.")
       .def_static(
           "from_view",
-          [](const py::object& sensor_argument, OMNICAL_VIEW_PARAMS, const std::string& interpolation, const py::object& progress) {
+          [](const py::object& sensor_argument, OMNICAL_VIEW_PARAMS, const std::string& interpolation,
+             const py::object& progress) {
             const SensorArgument sensor(sensor_argument);
             const ViewRequest request = ViewOf(OMNICAL_VIEW_FIELDS);
             const Interpolation chosen = InterpolationOf(interpolation);
@@ -377,7 +406,8 @@ Returns a RemapResult; InputError names the keyword ("size: '12' is not WxH ..."
           "from_tables",
           [](const py::object& map_x, const py::object& map_y, const std::pair<int, int>& image_size,
              const std::string& interpolation) {
-            return Unwarper(TableOf(py::make_tuple(map_x, map_y)), image_size.first, image_size.second, InterpolationOf(interpolation));
+            return Unwarper(TableOf(py::make_tuple(map_x, map_y)), image_size.first, image_size.second,
+                            InterpolationOf(interpolation));
           },
           "map_x"_a, "map_y"_a, "image_size"_a, py::kw_only(), "interpolation"_a = "linear",
           "From (H, W) tables (e.g. RemapResult.map_x/map_y) for images of image_size = (width, height).")
@@ -389,8 +419,9 @@ Returns a RemapResult; InputError names the keyword ("size: '12' is not WxH ..."
            R"(Every frame of an iterable (e.g. read from cv2.VideoCapture) unwarped and passed to
 write(frame); returns the number of frames. InputError naming `source` when there are no
 frames or one has the wrong size. progress stage "unwarp" against `total` (0: unknown).)")
-      .def_property_readonly("size", [](const Unwarper& u) { return py::make_tuple(u.width_px(), u.height_px()); },
-                             "(width, height) of the output, px.");
+      .def_property_readonly(
+          "size", [](const Unwarper& u) { return py::make_tuple(u.width_px(), u.height_px()); },
+          "(width, height) of the output, px.");
 
   m.def(
       "unwarp",
@@ -403,32 +434,49 @@ RemapResult or (map_x, map_y). image: uint8 grey or BGR of the sensor's size. Fo
 frames build an Unwarper once.)");
 
   // parallax ---------------------------------------------------------------------------
-  py::class_<PyParallax>(m, "ParallaxResult", R"(The viewpoint-distribution error of a central virtual projector at V0 (seed Eq. 23)
+  py::class_<PyParallax>(m, "ParallaxResult",
+                         R"(The viewpoint-distribution error of a central virtual projector at V0 (seed Eq. 23)
 for objects D mm away: the curve over the field and the map over the omni image.)")
-      .def_property_readonly("distance_mm", [](const PyParallax& p) { return p.result.distance_mm; }, "Object distance, mm.")
-      .def_property_readonly("n", [](const PyParallax& p) { return p.result.n; }, "Object distance in mirror rim radii.")
-      .def_property_readonly("v0_mm", [](const PyParallax& p) { return p.result.v0_mm; }, "V0, z on the mirror axis (mm).")
-      .def_property_readonly("v0_searched", [](const PyParallax& p) { return p.result.v0_searched; },
-                             "True when V0 minimises the worst pixel error (not given).")
-      .def_property_readonly("axial", [](const PyParallax& p) { return p.result.axial; },
-                             "False: the curve is the aligned counterpart's, the map the exact sensor's.")
-      .def_property_readonly("omega_deg", [](const PyParallax& p) { return CopyArray(p.result.curve.omega_deg); },
-                             "Curve: each sample's Omega (deg), float64 (samples,).")
-      .def_property_readonly("x_mm", [](const PyParallax& p) { return CopyArray(p.result.curve.x_mm); },
-                             "Curve: each sample's radius on the mirror, mm.")
-      .def_property_readonly("error_deg", [](const PyParallax& p) { return CopyArray(p.result.curve.error_deg); },
-                             "Curve: the angle error, deg (signed).")
-      .def_property_readonly("error_px", [](const PyParallax& p) { return CopyArray(p.result.curve.error_px); },
-                             "Curve: the error in omni-image px (signed).")
-      .def_property_readonly("max_abs_error_px", [](const PyParallax& p) { return p.result.curve.max_abs_error_px; },
-                             "Largest |error_px| of the curve.")
-      .def_property_readonly("max_abs_error_deg", [](const PyParallax& p) { return p.result.curve.max_abs_error_deg; },
-                             "Largest |error_deg| of the curve.")
       .def_property_readonly(
-          "error_map", [](const py::object& self) { const ParallaxMap& map = self.cast<const PyParallax&>().result.map; return TableView(map.error_px, map.width, map.height, self); },
+          "distance_mm", [](const PyParallax& p) { return p.result.distance_mm; }, "Object distance, mm.")
+      .def_property_readonly(
+          "n", [](const PyParallax& p) { return p.result.n; }, "Object distance in mirror rim radii.")
+      .def_property_readonly(
+          "v0_mm", [](const PyParallax& p) { return p.result.v0_mm; }, "V0, z on the mirror axis (mm).")
+      .def_property_readonly(
+          "v0_searched", [](const PyParallax& p) { return p.result.v0_searched; },
+          "True when V0 minimises the worst pixel error (not given).")
+      .def_property_readonly(
+          "axial", [](const PyParallax& p) { return p.result.axial; },
+          "False: the curve is the aligned counterpart's, the map the exact sensor's.")
+      .def_property_readonly(
+          "omega_deg", [](const PyParallax& p) { return CopyArray(p.result.curve.omega_deg); },
+          "Curve: each sample's Omega (deg), float64 (samples,).")
+      .def_property_readonly(
+          "x_mm", [](const PyParallax& p) { return CopyArray(p.result.curve.x_mm); },
+          "Curve: each sample's radius on the mirror, mm.")
+      .def_property_readonly(
+          "error_deg", [](const PyParallax& p) { return CopyArray(p.result.curve.error_deg); },
+          "Curve: the angle error, deg (signed).")
+      .def_property_readonly(
+          "error_px", [](const PyParallax& p) { return CopyArray(p.result.curve.error_px); },
+          "Curve: the error in omni-image px (signed).")
+      .def_property_readonly(
+          "max_abs_error_px", [](const PyParallax& p) { return p.result.curve.max_abs_error_px; },
+          "Largest |error_px| of the curve.")
+      .def_property_readonly(
+          "max_abs_error_deg", [](const PyParallax& p) { return p.result.curve.max_abs_error_deg; },
+          "Largest |error_deg| of the curve.")
+      .def_property_readonly(
+          "error_map",
+          [](const py::object& self) {
+            const ParallaxMap& map = self.cast<const PyParallax&>().result.map;
+            return TableView(map.error_px, map.width, map.height, self);
+          },
           "The error over the omni image, float32 (H, W) px, NaN where the pixel sees no mirror.")
-      .def_property_readonly("map_max_abs_error_px", [](const PyParallax& p) { return p.result.map.max_abs_error_px; },
-                             "Largest |error| of the map, px.")
+      .def_property_readonly(
+          "map_max_abs_error_px", [](const PyParallax& p) { return p.result.map.max_abs_error_px; },
+          "Largest |error| of the map, px.")
       .def(
           "save",
           [](const PyParallax& p, const py::object& out_dir, const py::object& sensor_path) {
@@ -458,13 +506,18 @@ for objects D mm away: the curve over the field and the map over the omni image.
 mirror (exactly one), V0 given or the best; samples over the mirror radius (10..100000);
 progress stage "parallax map". Returns a ParallaxResult.)");
 
-  py::class_<MapsErrorResult>(m, "MapsErrorResult", "How wrong a remap table on disk is for objects at other distances.")
-      .def_property_readonly("maps_dir", [](const MapsErrorResult& r) { return r.maps.dir; }, "The maps directory.")
-      .def_property_readonly("made_for", [](const MapsErrorResult& r) { return r.made_for; },
-                             "What the table is exact for: 'infinity' or 'a sphere at n = 7.000'.")
-      .def_property_readonly("v0_mm", [](const MapsErrorResult& r) { return r.maps.settings.v0_mm; }, "The table's V0, mm.")
-      .def_property_readonly("rim_radius_mm", [](const MapsErrorResult& r) { return r.rim_radius_mm; },
-                             "Rim radius of the sensor evaluated, mm.")
+  py::class_<MapsErrorResult>(m, "MapsErrorResult",
+                              "How wrong a remap table on disk is for objects at other distances.")
+      .def_property_readonly(
+          "maps_dir", [](const MapsErrorResult& r) { return r.maps.dir; }, "The maps directory.")
+      .def_property_readonly(
+          "made_for", [](const MapsErrorResult& r) { return r.made_for; },
+          "What the table is exact for: 'infinity' or 'a sphere at n = 7.000'.")
+      .def_property_readonly(
+          "v0_mm", [](const MapsErrorResult& r) { return r.maps.settings.v0_mm; }, "The table's V0, mm.")
+      .def_property_readonly(
+          "rim_radius_mm", [](const MapsErrorResult& r) { return r.rim_radius_mm; },
+          "Rim radius of the sensor evaluated, mm.")
       .def_property_readonly(
           "errors",
           [](const MapsErrorResult& r) {
@@ -474,7 +527,8 @@ progress stage "parallax map". Returns a ParallaxResult.)");
             return rows;
           },
           "[(n, distance_mm, max_px, rms_px, samples), ...], ascending n, inf (infinity) last; output px.")
-      .def("max_px_at", &MapsErrorResult::MaxPxAtN, "n"_a, "The largest error at n (one of the sweep's values), or NaN.")
+      .def("max_px_at", &MapsErrorResult::MaxPxAtN, "n"_a,
+           "The largest error at n (one of the sweep's values), or NaN.")
       .def(
           "save",
           [](const MapsErrorResult& r, const py::object& out_dir) {
@@ -483,13 +537,15 @@ progress stage "parallax map". Returns a ParallaxResult.)");
             WriteMapsErrorFiles(dir, r);
             WriteMapsErrorFigures(dir, r);
           },
-          "out_dir"_a, "Writes what `omnical parallax --maps` writes: maps-error.csv, maps-error.json, maps-error.png.");
+          "out_dir"_a,
+          "Writes what `omnical parallax --maps` writes: maps-error.csv, maps-error.json, maps-error.png.");
 
   m.def(
       "maps_error",
       [](const py::object& maps_dir, const py::object& sensor, int threads, const py::object& progress) {
         const MapsDescription maps = ReadMapsDescription(PathOf(maps_dir));
-        const std::optional<SensorArgument> given = sensor.is_none() ? std::nullopt : std::optional<SensorArgument>(sensor);
+        const std::optional<SensorArgument> given =
+            sensor.is_none() ? std::nullopt : std::optional<SensorArgument>(sensor);
         const std::optional<Sensor> own = given ? std::nullopt : std::optional<Sensor>(SensorOfMaps(maps));
         MapsErrorOptions options;
         options.threads = threads, options.progress = ForwardProgress(progress);
@@ -501,28 +557,42 @@ progress stage "parallax map". Returns a ParallaxResult.)");
 "remap error". Returns a MapsErrorResult.)");
 
   // export-central ---------------------------------------------------------------------
-  py::class_<PyCentral>(m, "CentralExportResult", "The best-fit central model (Mei or OCamCalib) of a sensor and its error.")
-      .def_property_readonly("model", [](const PyCentral& c) { return CentralModelKindName(c.result.model); }, "mei or ocamcalib.")
-      .def_property_readonly("fitted_for", [](const PyCentral& c) { return c.result.FittedForText(); },
-                             "'objects at infinity' or 'objects on a sphere of D mm around V0'.")
-      .def_property_readonly("v0_mm", [](const PyCentral& c) { return c.result.v0_mm; }, "The model's viewpoint V0, mm.")
-      .def_property_readonly("parameters", [](const PyCentral& c) { return CentralParameters(c.result); },
-                             "The fitted parameters as central.json has them (mei: fx, fy, cx, cy, skew, xi, k1, k2, p1, "
-                             "p2; ocamcalib: pol, invpol, xc_row, yc_col, c, d, e).")
+  py::class_<PyCentral>(m, "CentralExportResult",
+                        "The best-fit central model (Mei or OCamCalib) of a sensor and its error.")
+      .def_property_readonly(
+          "model", [](const PyCentral& c) { return CentralModelKindName(c.result.model); }, "mei or ocamcalib.")
+      .def_property_readonly(
+          "fitted_for", [](const PyCentral& c) { return c.result.FittedForText(); },
+          "'objects at infinity' or 'objects on a sphere of D mm around V0'.")
+      .def_property_readonly(
+          "v0_mm", [](const PyCentral& c) { return c.result.v0_mm; }, "The model's viewpoint V0, mm.")
+      .def_property_readonly(
+          "parameters", [](const PyCentral& c) { return CentralParameters(c.result); },
+          "The fitted parameters as central.json has them (mei: fx, fy, cx, cy, skew, xi, k1, k2, p1, "
+          "p2; ocamcalib: pol, invpol, xc_row, yc_col, c, d, e).")
       .def_property_readonly(
           "central_from_mirror",
-          [](const PyCentral& c) { return MatrixArray(c.result.model == CentralModelKind::kMei ? c.result.mei.central_from_mirror : c.result.ocam.central_from_mirror); },
+          [](const PyCentral& c) {
+            return MatrixArray(c.result.model == CentralModelKind::kMei ? c.result.mei.central_from_mirror
+                                                                        : c.result.ocam.central_from_mirror);
+          },
           "3x3: point_in_model = central_from_mirror @ (point_in_mirror - (0, 0, v0_mm)).")
-      .def_property_readonly("rms_px", [](const PyCentral& c) { return c.result.error.rms_px; }, "RMS error over the samples, omni px.")
-      .def_property_readonly("max_px", [](const PyCentral& c) { return c.result.error.max_px; }, "Largest error, omni px.")
-      .def_property_readonly("pixels", [](const PyCentral& c) { return PointRows(c.result.samples.pixels); },
-                             "The field samples' omni pixels, (N, 2).")
-      .def_property_readonly("points_in_mirror", [](const PyCentral& c) { return PointRows(c.result.samples.points_in_mirror); },
-                             "Their object points on the fitted surface, (N, 3) mm, mirror frame.")
-      .def_property_readonly("omega_deg", [](const PyCentral& c) { return CopyArray(c.result.error.omega_deg); },
-                             "Each sample's ray angle from the mirror axis, deg.")
-      .def_property_readonly("error_px", [](const PyCentral& c) { return CopyArray(c.result.error.error_px); },
-                             "Each sample's model error, omni px.")
+      .def_property_readonly(
+          "rms_px", [](const PyCentral& c) { return c.result.error.rms_px; }, "RMS error over the samples, omni px.")
+      .def_property_readonly(
+          "max_px", [](const PyCentral& c) { return c.result.error.max_px; }, "Largest error, omni px.")
+      .def_property_readonly(
+          "pixels", [](const PyCentral& c) { return PointRows(c.result.samples.pixels); },
+          "The field samples' omni pixels, (N, 2).")
+      .def_property_readonly(
+          "points_in_mirror", [](const PyCentral& c) { return PointRows(c.result.samples.points_in_mirror); },
+          "Their object points on the fitted surface, (N, 3) mm, mirror frame.")
+      .def_property_readonly(
+          "omega_deg", [](const PyCentral& c) { return CopyArray(c.result.error.omega_deg); },
+          "Each sample's ray angle from the mirror axis, deg.")
+      .def_property_readonly(
+          "error_px", [](const PyCentral& c) { return CopyArray(c.result.error.error_px); },
+          "Each sample's model error, omni px.")
       .def_property_readonly(
           "error_at_other_distances",
           [](const PyCentral& c) {
@@ -557,8 +627,8 @@ progress stage "parallax map". Returns a ParallaxResult.)");
         options.step_px = step_px, options.progress = ForwardProgress(progress);
         return PyCentral{RunReleased([&] { return ExportCentral(sensor.sensor(), options); }), sensor.source().file};
       },
-      "sensor"_a, py::kw_only(), "model"_a = "mei", "distance_mm"_a = py::none(), "n"_a = py::none(), "v0_mm"_a = py::none(),
-      "step_px"_a = CentralExportOptions{}.step_px, "progress"_a = py::none(),
+      "sensor"_a, py::kw_only(), "model"_a = "mei", "distance_mm"_a = py::none(), "n"_a = py::none(),
+      "v0_mm"_a = py::none(), "step_px"_a = CentralExportOptions{}.step_px, "progress"_a = py::none(),
       R"(The best-fit central model (`omnical export-central`): model "mei" (cv::omnidir) or
 "ocamcalib"; objects on a sphere of distance_mm or n rim radii around V0 (neither:
 infinity); V0 given or the best; field grid step_px (omni px). Progress stage
