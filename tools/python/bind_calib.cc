@@ -112,7 +112,6 @@ struct ImageInput {
 
 ImageInput ImagesOf(const py::handle& images) {
   ImageInput input;
-  input.source = "images";
   if (IsPath(images)) {
     input.source = PathOf(images);
     input.paths = ListImages(input.source);
@@ -136,7 +135,11 @@ ImageInput ImagesOf(const py::handle& images) {
     throw InputError("images: expected a directory or glob pattern, a list of paths or of uint8 arrays, or a dict "
                      "name -> array, got " + TypeName(images));
   }
-  if (input.paths.empty() && input.images.empty()) throw InputError("images: no images given");
+  const size_t count = input.paths.size() + input.images.size();
+  if (count == 0) throw InputError("images: no images given");
+  // Named in messages ("list of 2 images: images: ... too few"), as the CLI names the directory.
+  if (!IsPath(images))
+    input.source = (py::isinstance<py::dict>(images) ? "dict of " : "list of ") + std::to_string(count) + " images";
   return input;
 }
 
