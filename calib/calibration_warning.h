@@ -25,6 +25,10 @@ enum class WarningCode {
   kPredictedErrorHigh,        // the predicted projection error exceeds the threshold
 };
 
+// A stable lower-case name for programs (Python's CalibrationWarning.code), e.g.
+// "predicted_error_high".
+const char* WarningCodeName(WarningCode code);
+
 struct CalibrationWarning {
   WarningCode code;
   std::string subject;  // image path or parameter name; empty if about the whole run

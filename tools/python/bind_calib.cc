@@ -56,15 +56,6 @@ struct PyCalibration {
   CalibrationOptions report_options;  // what the report figures read (progress cleared)
 };
 
-// WarningCode's values in order, as Python sees them.
-const char* const kWarningCodes[] = {"image_unreadable",        "image_size_differs",  "checkerboard_refused",
-                                     "view_skipped",            "tolerance_not_applicable", "view_left_out",
-                                     "sensor_invalid",          "not_converged",       "free_gauge",
-                                     "weakly_determined",       "one_distance",        "tolerance_conflict",
-                                     "tolerance_note",          "predicted_error_unknown", "predicted_error_high"};
-static_assert(sizeof(kWarningCodes) / sizeof(kWarningCodes[0]) == static_cast<int>(WarningCode::kPredictedErrorHigh) + 1,
-              "one name per WarningCode");
-
 int ThreadsOf(int threads) { return threads == 0 ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency())) : threads; }
 
 bool IsPath(const py::handle& object) { return py::isinstance<py::str>(object) || py::hasattr(object, "__fspath__"); }
@@ -451,13 +442,13 @@ face, mm. Corner ids: aprilgrid 4 * tag_id + k (k = 0 bottom-left, 1 bottom-righ
 void BindDetections(py::module_& m) {
   py::class_<CalibrationWarning>(m, "CalibrationWarning", "Something a detection or calibration found questionable without failing.")
       .def_property_readonly(
-          "code", [](const CalibrationWarning& w) { return kWarningCodes[static_cast<int>(w.code)]; },
+          "code", [](const CalibrationWarning& w) { return WarningCodeName(w.code); },
           "What kind: image_unreadable, image_size_differs, checkerboard_refused, view_skipped, tolerance_not_applicable, "
           "view_left_out, sensor_invalid, not_converged, free_gauge, weakly_determined, one_distance, tolerance_conflict, "
           "tolerance_note, predicted_error_unknown, predicted_error_high.")
       .def_readonly("subject", &CalibrationWarning::subject, "The image or parameter it concerns ('' for the whole run).")
       .def_readonly("text", &CalibrationWarning::text, "The one-line message (what the CLI prints).")
-      .def("__repr__", [](const CalibrationWarning& w) { return "<omnical.CalibrationWarning " + std::string(kWarningCodes[static_cast<int>(w.code)]) + ": " + w.text + ">"; });
+      .def("__repr__", [](const CalibrationWarning& w) { return "<omnical.CalibrationWarning " + std::string(WarningCodeName(w.code)) + ": " + w.text + ">"; });
 
   py::class_<RimCircle>(m, "RimCircle", "The mirror's rim in an image: the circle where the bright mirror disc ends.")
       .def_property_readonly("centre_px", [](const RimCircle& c) { return py::make_tuple(c.centre_px.x(), c.centre_px.y()); }, "(u, v) px.")

@@ -353,7 +353,7 @@ class Unwarper:
                   plane_normal: Optional[Sequence[float]] = None, v0_mm: Optional[float] = None, threads: int = 0,
                   per_pixel: bool = False, interpolation: str = "linear", progress: _Progress = None) -> Unwarper: ...
     @staticmethod
-    def from_tables(map_x: npt._ArrayLike, map_y: npt._ArrayLike, image_size: Tuple[int, int], *,
+    def from_tables(map_x: npt.ArrayLike, map_y: npt.ArrayLike, image_size: Tuple[int, int], *,
                     interpolation: str = "linear") -> Unwarper: ...
     def apply(self, image: npt.NDArray[np.uint8]) -> npt.NDArray[np.uint8]: ...
     def apply_frames(self, frames: Iterable[npt.NDArray[np.uint8]],
@@ -363,7 +363,7 @@ class Unwarper:
     def size(self) -> Tuple[int, int]: ...
 
 def unwarp(image: npt.NDArray[np.uint8],
-           maps: Union[_Path, RemapResult, Tuple[npt._ArrayLike, npt._ArrayLike]], *,
+           maps: Union[_Path, RemapResult, Tuple[npt.ArrayLike, npt.ArrayLike]], *,
            interpolation: str = "linear") -> npt.NDArray[np.uint8]: ...
 
 class ParallaxResult:
