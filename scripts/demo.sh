@@ -54,4 +54,17 @@ for mirror in ohte-sph ohte-edi ohte-svp; do
   "$omnical" characterize --sensor "$sensor" --out "$out/$mirror-characterize"
   "$omnical" parallax --sensor "$sensor" --n 7 --out "$out/$mirror-parallax-n7"
 done
+# The Python module from the build tree (docs/python.md): the calibrated sensor projects the
+# same point as the CLI.
+if [ -d "$build_dir/python/omnical" ]; then
+  PYTHONPATH="$build_dir/python" "$(command -v /usr/bin/python3 || command -v python3)" - "$out/calibration/sensor.yaml" <<'PY'
+import sys
+import omnical
+sensor = omnical.Sensor.load(sys.argv[1])
+pixels, status = sensor.project([[400.0, -150.0, 60.0]])
+print(f"python: omnical {omnical.__version__}: {sensor!r} projects (400, -150, 60) mm to "
+      f"({pixels[0, 0]:.3f}, {pixels[0, 1]:.3f}) px ({omnical.status_name(status[0])})")
+PY
+  echo "python: PYTHONPATH=$build_dir/python python3 tools/python/examples/calibrate_and_unwarp.py example-out"
+fi
 echo "demo outputs in $out"

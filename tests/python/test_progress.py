@@ -65,6 +65,25 @@ def test_a_call_from_another_thread_reports_and_finishes(sensor):
     assert result["maps"][0].shape == (16, 64) and updates
 
 
+def test_calls_from_several_threads_at_once_give_the_sequential_answers(sensor, data):
+    other = omnical.Sensor.load(data / "sensors" / "ohte-edi.yaml")
+    jobs = [(sensor, "panorama", 7.0), (other, "perspective", 5.0), (sensor, "lonlat", 3.0), (other, "panorama", 9.0)]
+    sequential = [omnical.remap_tables(s, view, n=n, size=(96, 48)) for s, view, n in jobs]
+    results = [None] * len(jobs)
+
+    def run(i):
+        s, view, n = jobs[i]
+        results[i] = omnical.remap_tables(s, view, n=n, size=(96, 48), threads=1)
+    threads = [threading.Thread(target=run, args=(i,)) for i in range(len(jobs))]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(timeout=120)
+    for (x, y), (sx, sy) in zip(results, sequential):
+        np.testing.assert_array_equal(x, sx)
+        np.testing.assert_array_equal(y, sy)
+
+
 CHILD = textwrap.dedent("""
     import signal, sys, time
     import omnical

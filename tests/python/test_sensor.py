@@ -105,6 +105,10 @@ def test_any_layout_and_real_dtype_is_read_correctly(data):
     wide[::2, 1:4] = points
     np.testing.assert_array_equal(sensor.project(wide[::2, 1:4])[0], reference)
     np.testing.assert_array_equal(sensor.project(np.asfortranarray(points))[0], reference)
+    np.testing.assert_array_equal(sensor.project(points[::-1])[0], reference[::-1])
+    read_only = points.copy()
+    read_only.flags.writeable = False
+    np.testing.assert_array_equal(sensor.project(read_only)[0], reference)
     np.testing.assert_array_equal(sensor.project(points.tolist())[0], reference)
     # float32 and integers are converted to float64: same as projecting the converted values.
     single = points.astype(np.float32)
