@@ -10,6 +10,7 @@
 #include "calib/image_file.h"
 #include "calib/refine_corners.h"
 #include "model/input_error.h"
+#include "model/worker_threads.h"
 
 namespace omnical {
 namespace {
@@ -65,7 +66,7 @@ DetectedImages DetectAll(const CalibrationTarget& target, size_t count, const st
     }
   };
   std::vector<std::thread> pool;
-  for (int t = 1; t < options.threads; ++t) pool.emplace_back(work);
+  StartWorkers(std::min<int>(options.threads, static_cast<int>(count)), work, &pool);
   work();
   for (std::thread& t : pool) t.join();
   progress.ThrowIfCancelled();

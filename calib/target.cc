@@ -102,6 +102,10 @@ CalibrationTarget CalibrationTarget::AprilGrid(int cols, int rows, double tag_si
   const int total = fam->total_width, border = fam->width_at_border;
   const double needed = static_cast<double>(total - border) / border;
   const uint32_t ncodes = fam->ncodes;
+  if (!std::isfinite(spacing_ratio)) {
+    handle.destroy(fam);
+    throw std::invalid_argument("tagSpacing: must be a finite number");
+  }
   if (!(spacing_ratio >= needed)) {
     handle.destroy(fam);
     char text[160];

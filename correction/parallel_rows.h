@@ -8,6 +8,8 @@
 #include <thread>
 #include <vector>
 
+#include "model/worker_threads.h"
+
 namespace omnical {
 
 // Calls row(v) once for every v in [0, rows), from `threads` threads (at least one).
@@ -18,7 +20,7 @@ void ParallelRows(int rows, int threads, const RowFunction& row) {
     for (int v = next++; v < rows; v = next++) row(v);
   };
   std::vector<std::thread> pool;
-  for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(work);
+  StartWorkers(std::min(threads, rows), work, &pool);
   work();
   for (std::thread& thread : pool) thread.join();
 }

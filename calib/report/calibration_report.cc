@@ -40,7 +40,8 @@ void WritePredictedErrorMap(const std::string& path, const Sensor& sensor, const
   WritePng(path, picture);
 }
 
-void WriteReport(const std::filesystem::path& dir, const DetectionSet& detections, const FitResult& fit) {
+void WriteReport(const std::filesystem::path& dir, const DetectionSet& detections, const FitResult& fit,
+                 const std::vector<NamedImage>& images) {
   CreateOutputDirectory(dir);
   double worst = 0.0;
   std::vector<double> magnitudes;
@@ -52,7 +53,13 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
   cv::Mat coverage(detections.image_height_px, detections.image_width_px, CV_8UC3, cv::Scalar(30, 30, 30));
   for (size_t v = 0; v < detections.images.size(); ++v) {
     const ImageDetections& image = detections.images[v];
-    cv::Mat picture = ReadImageFile(image.image, cv::IMREAD_COLOR);
+    cv::Mat picture;
+    if (images.empty()) {
+      picture = ReadImageFile(image.image, cv::IMREAD_COLOR);
+    } else {  // in memory: never a file that happens to have the view's name
+      for (const NamedImage& named : images)
+        if (named.name == image.image) cv::cvtColor(named.grey, picture, cv::COLOR_GRAY2BGR);
+    }
     if (picture.empty()) picture = cv::Mat(detections.image_height_px, detections.image_width_px, CV_8UC3, cv::Scalar(40, 40, 40));
     for (size_t i = 0; i < image.corners.size(); ++i) {
       const cv::Point2d p(image.corners[i].pixel.x(), image.corners[i].pixel.y());
@@ -100,9 +107,10 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
 
 }  // namespace
 
-void WriteCalibrationReport(const std::string& dir, const CalibrationResult& result, const CalibrationOptions& options) {
+void WriteCalibrationReport(const std::string& dir, const CalibrationResult& result, const CalibrationOptions& options,
+                            const std::vector<NamedImage>& images) {
   const std::filesystem::path path(dir);
-  WriteReport(path, result.views, result.fit);
+  WriteReport(path, result.views, result.fit, images);
   for (size_t k = 0; k < result.predicted.size(); ++k)
     WritePredictedErrorMap((path / ("predicted_error_" + std::to_string(k) + ".png")).string(), result.sensor,
                            result.predicted[k], options.predicted_error_step_px, options.max_predicted_error_px,

@@ -10,6 +10,10 @@
 namespace omnical {
 
 // Writes the PNGs into `dir` (created); throws InputError naming a file it cannot write.
-void WriteCalibrationReport(const std::string& dir, const CalibrationResult& result, const CalibrationOptions& options);
+// The residuals are drawn on the views' pictures: `images` when the calibration was given
+// images in memory (CalibrationInput::images, matched by name), else the files the views
+// name; a view without either gets a grey background.
+void WriteCalibrationReport(const std::string& dir, const CalibrationResult& result, const CalibrationOptions& options,
+                            const std::vector<NamedImage>& images = {});
 
 }  // namespace omnical

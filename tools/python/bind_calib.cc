@@ -54,6 +54,7 @@ struct PyCalibration {
   CalibrationResult result;
   bool detected = false;              // corners found here: save() writes detections.json
   CalibrationOptions report_options;  // what the report figures read (progress cleared)
+  std::vector<NamedImage> images;     // given in memory: the report draws on them
 };
 
 int ThreadsOf(int threads) { return threads == 0 ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency())) : threads; }
@@ -86,7 +87,9 @@ std::optional<Sensor> GuessOf(const py::handle& guess, std::string* name, Design
 // A uint8 image as one grey channel (BGR and BGRA as cv2 reads them).
 cv::Mat GreyOf(const py::handle& array, const std::string& name) {
   const cv::Mat image = MatOf(array, name.c_str());
-  if (image.channels() == 1) return image;
+  // A copy: the array may go away while the job runs (a lazy sequence's temporary, a
+  // list emptied from the progress callback).
+  if (image.channels() == 1) return image.clone();
   cv::Mat grey;
   cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
   return grey;
@@ -94,7 +97,7 @@ cv::Mat GreyOf(const py::handle& array, const std::string& name) {
 
 // detect()'s and calibrate()'s `images`: a directory or glob pattern (as the CLI's
 // --images), a list of paths, a list of arrays (named by index) or a dict name -> array.
-// Arrays in memory are referred to, not copied: the caller keeps `images` alive.
+// Arrays in memory are copied (as grey), so nothing the caller does later can free them.
 struct ImageInput {
   std::vector<std::string> paths;
   std::vector<NamedImage> images;
@@ -261,6 +264,8 @@ std::set<std::string> FixedOf(const py::handle& fixed) {
       if (!block.empty()) blocks.insert(block);
     return blocks;
   }
+  if (!py::isinstance<py::iterable>(fixed))
+    throw InputError("fixed: expected block names (a list of str, or \"a,b\"), got " + TypeName(fixed));
   for (const py::handle block : fixed) {
     if (!py::isinstance<py::str>(block)) throw InputError("fixed: expected block names (str), got " + TypeName(block));
     blocks.insert(block.cast<std::string>());
@@ -324,7 +329,8 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
   options.max_predicted_error_px = max_predicted_error_px;
   options.rim_field_deg = rim_field_deg;
   options.progress = ForwardProgress(std::move(progress));
-  PyCalibration out{RunReleased([&] { return omnical::Calibrate(input, options); }), !input.detections, options};
+  PyCalibration out{RunReleased([&] { return omnical::Calibrate(input, options); }), !input.detections, options,
+                    std::move(input.images)};
   out.report_options.progress = nullptr;
   return out;
 }
@@ -336,7 +342,8 @@ void Save(const PyCalibration& calibration, const py::object& out_dir, bool repo
   SaveSensorYaml(calibration.result.sensor, (dir / "sensor.yaml").string());
   if (calibration.detected) WriteDetections(calibration.result.detections, (dir / "detections.json").string());
   WriteCalibrationJson(calibration.result.record, (dir / "calibration.json").string());
-  if (report) WriteCalibrationReport((dir / "report").string(), calibration.result, calibration.report_options);
+  if (report)
+    WriteCalibrationReport((dir / "report").string(), calibration.result, calibration.report_options, calibration.images);
 }
 
 // Kalibr's field names in the target factories' messages, as Python's argument names.

@@ -54,13 +54,16 @@ py::object NodeValue(const YAML::Node& node) {
 
 // A parameter dict back to YAML: numbers with Python's shortest round-trip text, NumPy
 // scalars and arrays included; anything else refused naming its key.
-void Emit(YAML::Emitter& out, const py::handle& value, const std::string& key) {
+void Emit(YAML::Emitter& out, const py::handle& value, const std::string& key, int depth = 0) {
+  // The sensor file nests three levels (section, field, list); a self-containing list or
+  // dict must not recurse forever.
+  if (depth > 8) throw InputError("parameters: " + key + ": nested too deeply");
   if (py::isinstance<py::dict>(value)) {
     out << YAML::BeginMap;
     for (const auto& entry : py::reinterpret_borrow<py::dict>(value)) {
       const std::string name = py::str(entry.first);
       out << YAML::Key << name << YAML::Value;
-      Emit(out, entry.second, key.empty() ? name : key + "." + name);
+      Emit(out, entry.second, key.empty() ? name : key + "." + name, depth + 1);
     }
     out << YAML::EndMap;
   } else if (py::isinstance<py::str>(value)) {
@@ -68,10 +71,10 @@ void Emit(YAML::Emitter& out, const py::handle& value, const std::string& key) {
   } else if (py::isinstance<py::bool_>(value)) {
     out << (value.cast<bool>() ? "true" : "false");
   } else if (py::hasattr(value, "tolist") && !py::isinstance<py::float_>(value)) {
-    Emit(out, value.attr("tolist")(), key);  // NumPy arrays and scalars
+    Emit(out, value.attr("tolist")(), key, depth + 1);  // NumPy arrays and scalars
   } else if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
     out << YAML::Flow << YAML::BeginSeq;
-    for (const auto& item : value) Emit(out, item, key);
+    for (const auto& item : value) Emit(out, item, key, depth + 1);
     out << YAML::EndSeq;
   } else if (py::isinstance<py::int_>(value)) {
     out << std::string(py::str(value));

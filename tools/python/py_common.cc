@@ -21,6 +21,14 @@ void OnSigint(int signal) {
     g_python_sigint.sa_handler(signal);
 }
 
+bool Finalizing() {
+#if PY_VERSION_HEX >= 0x030D0000
+  return Py_IsFinalizing();
+#else
+  return _Py_IsFinalizing();
+#endif
+}
+
 bool OnMainThread() {
   const py::object threading = py::module_::import("threading");
   return threading.attr("current_thread")().is(threading.attr("main_thread")());
@@ -32,29 +40,38 @@ std::string ShapeText(const py::array& array) {
   return text + (array.ndim() == 1 ? ",)" : ")");
 }
 
-// While a long call runs on the main thread, SIGINT also sets g_interrupted. Only the
-// main thread gets KeyboardInterrupt; a call from another thread is cancelled through its
-// progress callback alone. Nested calls (a callback calling omnical) keep the outer watch.
+// While a long call runs on the main thread, SIGINT also sets g_interrupted, which every
+// progress callback reads (a Ctrl-C stops the jobs of other threads running meanwhile too:
+// it means stop). Not installed when Python ignores SIGINT or leaves it at the default
+// action (the user's choice stands), nor for calls from other threads (only the main
+// thread gets KeyboardInterrupt; they stop through their progress callback), nor for
+// nested calls (a callback calling omnical keeps the outer watch).
 class SigintWatch {
  public:
-  SigintWatch() : active_(depth_ == 0 && OnMainThread()) {
-    ++depth_;
-    if (!active_) return;
+  SigintWatch() {
+    const bool outermost = depth_++ == 0;
+    if (!outermost || !OnMainThread()) return;
+    struct sigaction current = {};
+    sigaction(SIGINT, nullptr, &current);
+    if (current.sa_handler == SIG_IGN || current.sa_handler == SIG_DFL || (current.sa_flags & SA_SIGINFO)) return;
     g_interrupted = false;
     struct sigaction ours = {};
     ours.sa_handler = OnSigint;
     sigemptyset(&ours.sa_mask);
     sigaction(SIGINT, &ours, &g_python_sigint);
+    active_ = true;
   }
   ~SigintWatch() {
     --depth_;
-    if (active_) sigaction(SIGINT, &g_python_sigint, nullptr);
+    if (!active_) return;
+    sigaction(SIGINT, &g_python_sigint, nullptr);
+    g_interrupted = false;  // no stale flag for later calls
   }
   bool interrupted() const { return active_ && g_interrupted; }
 
  private:
   static inline int depth_ = 0;  // guarded by the GIL
-  bool active_;
+  bool active_ = false;
 };
 
 }  // namespace
@@ -77,17 +94,26 @@ RowsArray RowsOf(const py::handle& object, int columns, const char* name) {
     throw InputError(expected + ", got shape " + ShapeText(array) + hint);
   }
   // float32, integers and non-contiguous views: one converting copy into C order.
-  return RowsArray::ensure(array);
+  RowsArray rows = RowsArray::ensure(array);
+  if (!rows) {  // the copy failed: ensure() clears the error, which can only be memory here
+    PyErr_NoMemory();
+    throw py::error_already_set();
+  }
+  return rows;
 }
 
 std::string PathOf(const py::handle& path) {
   const py::object os = py::module_::import("os");
+  std::string text;
   try {
-    return py::str(os.attr("fspath")(path));
+    text = py::str(os.attr("fspath")(path));
   } catch (const py::error_already_set&) {
     throw InputError("expected a path (str or os.PathLike), got " +
                      std::string(py::str(py::type::of(path).attr("__name__"))));
   }
+  // The C++ side would read the path only up to the NUL: another file.
+  if (text.find('\0') != std::string::npos) throw InputError(text.substr(0, text.find('\0')) + ": path contains a NUL character");
+  return text;
 }
 
 ProgressCallback ForwardProgress(py::object progress) {
@@ -99,10 +125,15 @@ ProgressCallback ForwardProgress(py::object progress) {
     delete p;
   });
   return [callback](const ProgressUpdate& update) {
-    if (g_interrupted) return false;
+    // A daemon thread's job while the interpreter exits: taking the GIL would end the
+    // thread from inside the library; stop the job instead.
+    if (g_interrupted || Finalizing()) return false;
     py::gil_scoped_acquire gil;
     const py::object answer = (*callback)(update.stage, update.done, update.total);
-    return answer.is_none() || PyObject_IsTrue(answer.ptr()) == 1;
+    if (answer.is_none()) return true;
+    const int truth = PyObject_IsTrue(answer.ptr());
+    if (truth < 0) throw py::error_already_set();  // its __bool__ raised: the caller gets that
+    return truth == 1;
   };
 }
 
@@ -115,10 +146,10 @@ void RunReleasedImpl(const std::function<void()>& job) {
   } catch (const Cancelled&) {
     if (!watch.interrupted()) throw;  // the callback said stop: omnical.Cancelled
   }
-  // Python's handler saw the signal too: let it raise (KeyboardInterrupt by default).
+  // Python's handler saw the signal too: let it raise (KeyboardInterrupt by default); a
+  // handler of the user's that does not raise leaves the job cancelled.
   if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-  PyErr_SetNone(PyExc_KeyboardInterrupt);
-  throw py::error_already_set();
+  throw Cancelled("an interrupt (SIGINT)");
 }
 
 }  // namespace omnical::python

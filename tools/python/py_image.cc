@@ -9,7 +9,7 @@ namespace omnical::python {
 namespace py = pybind11;
 
 cv::Mat MatOf(const py::handle& image, const char* name) {
-  const std::string expected = std::string(name) + ": expected an (H, W) or (H, W, 3) uint8 image";
+  const std::string expected = std::string(name) + ": expected an (H, W) or (H, W, 1|3|4) uint8 image";
   if (!py::isinstance<py::array>(image))
     throw InputError(expected + ", got " + std::string(py::str(py::type::of(image).attr("__name__"))));
   const auto array = py::reinterpret_borrow<py::array>(image);

@@ -1,0 +1,126 @@
+"""Input that once crashed the module or misbehaved (found by an adversarial review): each
+must now give a clean answer or a clean error. Crash-prone cases run in a subprocess, so a
+crash fails the test instead of ending the suite."""
+import collections.abc
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+
+import cv2
+import numpy as np
+import pytest
+
+import omnical
+
+
+def run_child(code, *args, timeout=120):
+    return subprocess.run([sys.executable, "-c", textwrap.dedent(code), *map(str, args)], capture_output=True,
+                          text=True, timeout=timeout, env=os.environ)
+
+
+def test_images_from_a_lazy_sequence_of_temporaries(data):
+    """Each __getitem__ returns a new array that nothing else holds: the job must not keep
+    pointers into it."""
+    paths = sorted((data / "rendered" / "ohte-sph-near").glob("near00[0-2].png"))
+
+    class Lazy(collections.abc.Sequence):
+        def __len__(self):
+            return len(paths)
+
+        def __getitem__(self, i):
+            if i >= len(paths):
+                raise IndexError
+            return cv2.imread(str(paths[i]), cv2.IMREAD_GRAYSCALE)
+    target = data / "targets" / "aprilgrid-6x6-30mm.yaml"
+    lazy = omnical.detect(target, Lazy(), threads=2)
+    from_files = omnical.detect(target, [str(p) for p in paths], threads=2)
+    for a, b in zip(lazy.images, from_files.images):
+        np.testing.assert_array_equal(a.ids, b.ids)
+        np.testing.assert_array_equal(a.pixels, b.pixels)
+
+
+def test_a_conversion_that_runs_out_of_memory_raises_memory_error():
+    completed = run_child("""
+        import numpy as np, omnical, sys
+        sensor = omnical.Sensor.load(sys.argv[1])
+        try:
+            sensor.project(np.broadcast_to(1.0, (3_000_000_000, 3)))
+        except MemoryError:
+            print("memory error")
+    """, os.path.join(os.environ.get("OMNICAL_SOURCE_DIR", "."), "datasets-synthetic/sensors/ohte-sph.yaml"))
+    assert completed.returncode == 0 and completed.stdout.strip() == "memory error", completed.stderr
+
+
+def test_a_daemon_thread_in_a_job_does_not_abort_the_exit(data):
+    completed = run_child("""
+        import sys, threading, time, omnical
+        sensor = omnical.Sensor.load(sys.argv[1])
+        threading.Thread(target=lambda: omnical.remap(sensor, "perspective", size=(4000, 3000), n=3, per_pixel=True,
+                                                      threads=1, progress=lambda *a: None), daemon=True).start()
+        time.sleep(0.5)
+    """, data / "sensors" / "ohte-sph-misaligned.yaml")
+    assert completed.returncode == 0, completed.stderr
+
+
+def test_self_containing_parameters_are_refused(data):
+    parameters = omnical.Sensor.load(data / "sensors" / "ohte-sph.yaml").parameters
+    loop = []
+    loop.append(loop)
+    parameters["camera"]["k1"] = loop
+    with pytest.raises(omnical.InputError, match="nested too deeply"):
+        omnical.Sensor.from_parameters(parameters)
+
+
+def test_a_huge_thread_count_is_cut_not_fatal(data):
+    sensor = omnical.Sensor.load(data / "sensors" / "ohte-sph.yaml")
+    many = omnical.remap_tables(sensor, "panorama", size=(50, 20), infinity=True, threads=100000)
+    one = omnical.remap_tables(sensor, "panorama", size=(50, 20), infinity=True, threads=1)
+    np.testing.assert_array_equal(many[0], one[0])
+
+
+def test_a_callback_whose_answer_cannot_be_read_reaches_the_caller(data):
+    class Unreadable:
+        def __bool__(self):
+            raise ValueError("no truth here")
+    sensor = omnical.Sensor.load(data / "sensors" / "ohte-sph.yaml")
+    with pytest.raises(ValueError, match="no truth here"):
+        omnical.remap(sensor, size=(40, 10), n=3, progress=lambda *a: Unreadable())
+
+
+def test_ignored_sigint_stays_ignored_and_no_stale_interrupt_remains(data):
+    completed = run_child("""
+        import os, signal, sys, threading, omnical
+        sensor = omnical.Sensor.load(sys.argv[1])
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        sent = []
+        def progress(stage, done, total):
+            if not sent:
+                sent.append(os.kill(os.getpid(), signal.SIGINT))
+        omnical.remap(sensor, size=(200, 50), n=3, threads=1, progress=progress)
+        print("ignored")
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        try:
+            omnical.remap(sensor, size=(4000, 1000), n=3, per_pixel=True, threads=1,
+                          progress=lambda *a: sent.append(None) if len(sent) > 1 else sent.append(os.kill(os.getpid(), signal.SIGINT)))
+        except KeyboardInterrupt:
+            print("interrupted")
+        result = []
+        worker = threading.Thread(target=lambda: result.append(omnical.remap_tables(sensor, size=(40, 10), n=3)))
+        worker.start(); worker.join()
+        print("thread ok" if result else "thread failed")
+    """, data / "sensors" / "ohte-sph.yaml")
+    assert completed.stdout.splitlines() == ["ignored", "interrupted", "thread ok"], completed.stderr
+    assert completed.returncode == 0
+
+
+def test_bad_values_that_once_slipped_through(data, tmp_path):
+    with pytest.raises(omnical.InputError, match="spacing_ratio: must be a finite number"):
+        omnical.Target.aprilgrid(6, 6, 30.0, float("inf"))
+    with pytest.raises(omnical.InputError, match="path contains a NUL character"):
+        omnical.Sensor.load(str(data / "sensors" / "ohte-sph.yaml") + "\0junk")
+    target = data / "targets" / "aprilgrid-6x6-30mm.yaml"
+    detections = omnical.detect(target, [data / "rendered" / "ohte-sph-near" / "near000.png"])
+    with pytest.raises(omnical.InputError, match="^fixed: expected block names"):
+        omnical.calibrate(target, detections=detections, fixed=5)
