@@ -185,7 +185,8 @@ std::string CalibrationOptions::Check() const {
   if (!(rim_field_deg > 10.0 && rim_field_deg < 170.0)) return "rim_field_deg: must lie in (10, 170) deg";
   if (!(loss_px >= 0.0 && std::isfinite(loss_px))) return "loss_px: must be >= 0 and finite";
   if (max_iterations < 1) return "max_iterations: must be >= 1";
-  if (detection_passes < 1) return "detection_passes: must be >= 1";
+  // Pass 2 re-detects through the first fit; later passes change nothing measurable.
+  if (detection_passes < 1 || detection_passes > 5) return "detection_passes: must be 1..5";
   if (threads < 1) return "threads: must be >= 1";
   for (double d : distances_mm)
     if (!(d > 0.0 && std::isfinite(d))) return "distances_mm: must be > 0 and finite";

@@ -124,3 +124,8 @@ def test_bad_values_that_once_slipped_through(data, tmp_path):
     detections = omnical.detect(target, [data / "rendered" / "ohte-sph-near" / "near000.png"])
     with pytest.raises(omnical.InputError, match="^fixed: expected block names"):
         omnical.calibrate(target, detections=detections, fixed=5)
+    with pytest.raises(omnical.InputError, match="^detection_passes: must be 1..5"):
+        omnical.calibrate(target, detections=detections, detection_passes=10**6)
+    image = cv2.imread(str(data / "rendered" / "ohte-sph-near" / "near000.png"))
+    with pytest.raises(omnical.InputError, match="^maps: expected"):
+        omnical.unwarp(image, (np.zeros((0, 0)), np.zeros((0, 0))))

@@ -337,7 +337,7 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
 
 void Save(const PyCalibration& calibration, const py::object& out_dir, bool report) {
   const std::filesystem::path dir(PathOf(out_dir));
-  py::gil_scoped_release release;  // the report's figures take a moment
+  GilReleased release;  // the report's figures take a moment
   CreateOutputDirectory(dir.string());
   SaveSensorYaml(calibration.result.sensor, (dir / "sensor.yaml").string());
   if (calibration.detected) WriteDetections(calibration.result.detections, (dir / "detections.json").string());

@@ -171,7 +171,7 @@ void SaveRemap(const PyRemap& remap, const py::object& out_dir, const py::object
   const std::string dir = PathOf(out_dir);
   const std::vector<MapFormat> parsed = FormatsOf(formats);
   const SensorSource source = SourceFor(sensor_path, remap.sensor);
-  py::gil_scoped_release release;
+  GilReleased release;
   WriteRemapOutputs(dir, remap.result, parsed, source);
   WriteRemapFigures(dir, remap.result);
 }
@@ -190,7 +190,7 @@ RemapTable TableOf(const py::handle& maps) {
   using Floats = py::array_t<float, py::array::c_style | py::array::forcecast>;
   const Floats map_x = Floats::ensure(maps[py::int_(0)]), map_y = Floats::ensure(maps[py::int_(1)]);
   if (!map_x || !map_y || map_x.ndim() != 2 || map_y.ndim() != 2 || map_x.shape(0) != map_y.shape(0) ||
-      map_x.shape(1) != map_y.shape(1)) {
+      map_x.shape(1) != map_y.shape(1) || map_x.size() == 0) {
     PyErr_Clear();
     throw InputError(expected);
   }
@@ -205,7 +205,7 @@ py::array Apply(const Unwarper& unwarper, const py::object& image) {
   const cv::Mat frame = MatOf(image, "image");
   cv::Mat unwarped;
   {
-    py::gil_scoped_release release;
+    GilReleased release;
     unwarped = unwarper.Apply(frame, "image");
   }
   return ArrayOf(unwarped);
@@ -482,7 +482,7 @@ for objects D mm away: the curve over the field and the map over the omni image.
           [](const PyParallax& p, const py::object& out_dir, const py::object& sensor_path) {
             const std::string dir = PathOf(out_dir);
             const std::string sensor_file = sensor_path.is_none() ? p.sensor_file : PathOf(sensor_path);
-            py::gil_scoped_release release;
+            GilReleased release;
             WriteParallaxFiles(dir, p.result, sensor_file);
             WriteParallaxFigures(dir, p.result);
           },
@@ -533,7 +533,7 @@ progress stage "parallax map". Returns a ParallaxResult.)");
           "save",
           [](const MapsErrorResult& r, const py::object& out_dir) {
             const std::string dir = PathOf(out_dir);
-            py::gil_scoped_release release;
+            GilReleased release;
             WriteMapsErrorFiles(dir, r);
             WriteMapsErrorFigures(dir, r);
           },
@@ -607,7 +607,7 @@ progress stage "parallax map". Returns a ParallaxResult.)");
           [](const PyCentral& c, const py::object& out_dir, const py::object& sensor_path) {
             const std::string dir = PathOf(out_dir);
             const std::string sensor_file = sensor_path.is_none() ? c.sensor_file : PathOf(sensor_path);
-            py::gil_scoped_release release;
+            GilReleased release;
             WriteCentralExport(dir, c.result, sensor_file);
             WriteCentralExportFigures(dir, c.result);
           },

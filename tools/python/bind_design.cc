@@ -127,7 +127,7 @@ void SaveRendered(const std::shared_ptr<Scene>& scene, const std::vector<const P
   }
   const std::string dir = PathOf(out_dir);
   const std::string index_scene = scene_path.is_none() ? scene->path : PathOf(scene_path);
-  py::gil_scoped_release release;
+  GilReleased release;
   WriteRenderedScene(*scene, index_scene, rendered, dir);
 }
 
@@ -280,7 +280,7 @@ DesignOdeResult DesignOde(const py::object& spec_path, const std::optional<std::
 void SaveOde(const DesignOdeResult& r, const py::object& out_dir) {
   const std::filesystem::path dir(PathOf(out_dir));
   const std::string table_file = DesignOdeOptions().table_file;  // the name the sensor's mirror.table gives
-  py::gil_scoped_release release;
+  GilReleased release;
   CreateOutputDirectory(dir.string());
   WriteProfileTable(r.profile, "design ode", (dir / table_file).string());
   WriteOdeDesignSensorYaml(r, table_file, (dir / "sensor.yaml").string());
@@ -444,7 +444,7 @@ measured through its own model (model/design/mirror_design_fit.h).)")
           "save",
           [](const DesignFitResult& r, const py::object& out_dir) {
             const std::filesystem::path dir(PathOf(out_dir));
-            py::gil_scoped_release release;
+            GilReleased release;
             CreateOutputDirectory(dir.string());
             SaveSensorYaml(r.sensor, (dir / "sensor.yaml").string());
             WriteProfileTable(r.profile, "design fit", (dir / "profile.csv").string());
@@ -603,7 +603,7 @@ blur and depth of field over the mirror.)");
           "save",
           [](const PyCharacterization& c, const py::object& out_dir) {
             const std::filesystem::path dir(PathOf(out_dir));
-            py::gil_scoped_release release;
+            GilReleased release;
             CreateOutputDirectory(dir.string());
             WriteCharacteristicsCsv(c.result, (dir / "characteristics.csv").string());
             WriteCharacterizeSummaryJson(c.result, c.sensor_file, (dir / "summary.json").string());

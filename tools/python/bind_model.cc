@@ -93,7 +93,7 @@ py::tuple Project(const Sensor& sensor, const py::handle& points) {
   Eigen::Matrix2Xd pixels;
   std::vector<ProjectionStatus> statuses;
   {
-    py::gil_scoped_release release;
+    GilReleased release;
     sensor.ProjectBatch(AsColumns<3>(rows), &pixels, &statuses);
   }
   return py::make_tuple(RowsArrayOf<2>(std::move(pixels)), StatusArray(std::move(statuses)));
@@ -104,7 +104,7 @@ py::tuple Unproject(const Sensor& sensor, const py::handle& pixels) {
   Eigen::Matrix3Xd origins, directions;
   std::vector<ProjectionStatus> statuses;
   {
-    py::gil_scoped_release release;
+    GilReleased release;
     sensor.UnprojectBatch(AsColumns<2>(rows), &origins, &directions, &statuses);
   }
   return py::make_tuple(RowsArrayOf<3>(std::move(origins)), RowsArrayOf<3>(std::move(directions)),

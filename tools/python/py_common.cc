@@ -1,6 +1,8 @@
 #include "tools/python/py_common.h"
 
 #include <atomic>
+#include <chrono>
+#include <thread>
 #include <csignal>
 #include <string>
 
@@ -76,6 +78,12 @@ class SigintWatch {
 
 }  // namespace
 
+GilReleased::~GilReleased() {
+  if (Finalizing())
+    for (;;) std::this_thread::sleep_for(std::chrono::hours(1));
+  PyEval_RestoreThread(state_);
+}
+
 RowsArray RowsOf(const py::handle& object, int columns, const char* name) {
   const std::string expected = std::string(name) + ": expected an (N, " + std::to_string(columns) + ") array of numbers";
   py::array array;
@@ -140,7 +148,7 @@ ProgressCallback ForwardProgress(py::object progress) {
 void RunReleasedImpl(const std::function<void()>& job) {
   SigintWatch watch;
   try {
-    py::gil_scoped_release release;
+    GilReleased release;
     job();
     return;
   } catch (const Cancelled&) {

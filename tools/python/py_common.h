@@ -53,6 +53,21 @@ py::array_t<T> VectorArray(std::vector<T>&& values) {
   return py::array_t<T>({static_cast<py::ssize_t>(owned->size())}, owned->data(), owner);
 }
 
+// The GIL released for the scope, as py::gil_scoped_release, except at interpreter exit:
+// there CPython ends a daemon thread that takes the GIL back with pthread_exit, whose
+// unwinding cannot pass C++ destructors; such a thread waits for the process to end
+// instead (what CPython 3.14 itself does).
+class GilReleased {
+ public:
+  GilReleased() : state_(PyEval_SaveThread()) {}
+  ~GilReleased();
+  GilReleased(const GilReleased&) = delete;
+  GilReleased& operator=(const GilReleased&) = delete;
+
+ private:
+  PyThreadState* state_;
+};
+
 // A path argument: str or os.PathLike.
 std::string PathOf(const py::handle& path);
 
