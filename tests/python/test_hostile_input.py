@@ -129,3 +129,27 @@ def test_bad_values_that_once_slipped_through(data, tmp_path):
     image = cv2.imread(str(data / "rendered" / "ohte-sph-near" / "near000.png"))
     with pytest.raises(omnical.InputError, match="^maps: expected"):
         omnical.unwarp(image, (np.zeros((0, 0)), np.zeros((0, 0))))
+
+
+def test_ctrl_c_reaches_a_main_thread_call_while_another_thread_works(data):
+    completed = run_child("""
+        import os, signal, sys, threading, time, omnical
+        sensor = omnical.Sensor.load(sys.argv[1])
+        started = threading.Event()
+        def background():
+            omnical.remap(sensor, size=(2000, 1500), n=3, per_pixel=True, threads=1,
+                          progress=lambda *a: started.set())
+        worker = threading.Thread(target=background, daemon=True)
+        worker.start()
+        started.wait()
+        threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+        start = time.monotonic()
+        try:
+            omnical.remap(sensor, "panorama", size=(8192, 4096), n=7, per_pixel=True, threads=1)
+            print("finished")
+        except KeyboardInterrupt:
+            print(f"interrupted {time.monotonic() - start:.1f}")
+    """, data / "sensors" / "ohte-sph-misaligned.yaml")
+    words = completed.stdout.split()
+    # The main-thread table takes ~11 s alone; the interrupt at 0.5 s must end it early.
+    assert words[0] == "interrupted" and float(words[1]) < 5.0, (completed.stdout, completed.stderr)

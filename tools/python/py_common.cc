@@ -2,9 +2,9 @@
 
 #include <atomic>
 #include <chrono>
-#include <thread>
 #include <csignal>
 #include <string>
+#include <thread>
 
 #include "model/input_error.h"
 
@@ -51,8 +51,11 @@ std::string ShapeText(const py::array& array) {
 class SigintWatch {
  public:
   SigintWatch() {
-    const bool outermost = depth_++ == 0;
-    if (!outermost || !OnMainThread()) return;
+    // Counted on the main thread only: another thread's call running meanwhile must not
+    // make a main-thread call look nested.
+    if (!OnMainThread()) return;
+    counted_ = true;
+    if (depth_++ != 0) return;
     struct sigaction current = {};
     sigaction(SIGINT, nullptr, &current);
     if (current.sa_handler == SIG_IGN || current.sa_handler == SIG_DFL || (current.sa_flags & SA_SIGINFO)) return;
@@ -64,7 +67,7 @@ class SigintWatch {
     active_ = true;
   }
   ~SigintWatch() {
-    --depth_;
+    if (counted_) --depth_;
     if (!active_) return;
     sigaction(SIGINT, &g_python_sigint, nullptr);
     g_interrupted = false;  // no stale flag for later calls
@@ -72,8 +75,8 @@ class SigintWatch {
   bool interrupted() const { return active_ && g_interrupted; }
 
  private:
-  static inline int depth_ = 0;  // guarded by the GIL
-  bool active_ = false;
+  static inline int depth_ = 0;  // main-thread calls in progress; guarded by the GIL
+  bool counted_ = false, active_ = false;
 };
 
 }  // namespace
