@@ -38,10 +38,13 @@ class ProgressReporter {
  public:
   ProgressReporter(ProgressCallback callback, std::string stage, long total)
       : callback_(std::move(callback)), stage_(std::move(stage)), total_(total) {
-    Report(0);
+    Report();
   }
   // False once the caller asked to stop.
-  bool Advance(long amount = 1) { return Report(done_ += amount); }
+  bool Advance(long amount = 1) {
+    done_ += amount;
+    return Report();
+  }
   bool cancelled() const { return cancelled_; }
   // Rethrows what the callback threw (it may run on a worker thread, where an exception
   // would end the process), else Cancelled.
@@ -57,12 +60,14 @@ class ProgressReporter {
   }
 
  private:
-  bool Report(long done) {
+  bool Report() {
     if (cancelled_) return false;
     if (!callback_) return true;
     std::lock_guard<std::mutex> lock(mutex_);
     try {
-      if (!callback_({stage_, done, total_})) cancelled_ = true;
+      // The count read under the lock: reports from several threads never go backwards,
+      // and the last one has the total.
+      if (!callback_({stage_, done_.load(), total_})) cancelled_ = true;
     } catch (...) {
       if (!thrown_) thrown_ = std::current_exception();
       cancelled_ = true;
