@@ -16,6 +16,13 @@
 // the same surface, so its tilt is not observable (its centre is): the defaults fix it.
 // A free polynomial mirror and the lens's radial distortion bend the same radial mapping:
 // the defaults hold k1, k2 and let the mirror shape absorb them.
+//
+// The pieces: the options (calib/fit_options.h), the cost (calib/reprojection_cost.h),
+// the blocks packed from the registry (calib/sensor_blocks.h), the covariance
+// (calib/fit_covariance.h). The stages, in order: the poses alone through the guess;
+// everything but the distortion; everything asked for; (robust mode) outliers and
+// ill-fitting views removed, then a Huber solve; the priors re-weighted to the final noise;
+// the covariance.
 #pragma once
 
 #include <Eigen/Core>
@@ -27,48 +34,13 @@
 #include <vector>
 
 #include "calib/detections.h"
+#include "calib/fit_options.h"
 #include "calib/target.h"
+#include "model/parameter_field.h"
 #include "model/progress.h"
 #include "model/sensor.h"
 
 namespace omnical {
-
-struct FitOptions {
-  std::set<std::string> fixed;  // block names: lens, lens_scale, distortion (k1, k2), m, tilt, decenter, shape, poses
-  double robust_loss_px = 1.0;  // robust scale in px (Cauchy, outlier removal, then Huber); 0 = plain least squares
-  int max_iterations = 200;
-  bool compute_covariance = true;
-  // Outliers (robust mode): |residual| beyond max(outlier_floor_px, outlier_sigmas x a
-  // robust sigma of the residuals) are removed. The floor keeps a very good fit (renders:
-  // 0.02 px) from throwing good corners away; 4 sigma of a 2-D Gaussian's |e| cuts 3e-4.
-  double outlier_floor_px = 0.5;
-  double outlier_sigmas = 4.0;
-  // A view whose inlier RMS exceeds max(outlier_floor_px, view_rms_ratio x the median of
-  // the views' RMS) is left out (robust mode): it shows something else than the other
-  // views' board. Real views differ by up to 2.5x (measured on the dev set).
-  double view_rms_ratio = 4.0;
-  // Design tolerances: one standard deviation of a Gaussian prior around the guess's value,
-  // per parameter name as FitResult names them (fx_px, cx_px, k1, m_mm, decenter_x_mm,
-  // A_mm, ...) or a pair: tilt_deg, decenter_mm, principal_point_px, focal_px. They pull
-  // the fit towards the design (a weak prior residual: the wrong basins of the camera
-  // rotation / decenter / distortion valley lie many tolerances away) and enter the
-  // covariance. A tolerance on a held parameter is ignored (FitResult::tolerance_notes
-  // says so); on a sphere with its tilt held, a tilt tolerance widens the decenter's.
-  std::map<std::string, double> tolerances;
-  // The design values the tolerances are centred on, by parameter name (reported units);
-  // a parameter not named here is centred on the guess's value. A pipeline that fits
-  // several times (a second detection pass from the first fit) keeps the user's design.
-  std::map<std::string, double> design;
-  // Stage "fit", one step per solver iteration; returning false cancels (Cancelled).
-  ProgressCallback progress;
-
-  // The gauge-fixing defaults for a sensor (see above).
-  static FitOptions DefaultsFor(const Sensor& sensor);
-  // Empty if valid, else "field: problem".
-  std::string Check() const;
-  // Check() and the tolerance names against the sensor's parameters ("tolerances.x: ...").
-  std::string CheckFor(const Sensor& sensor) const;
-};
 
 struct TargetPose {
   Eigen::Quaterniond camera_from_target_rotation = Eigen::Quaterniond::Identity();
@@ -80,6 +52,8 @@ struct ParameterEstimate {
   double value = 0.0;
   double std = 0.0;  // from (J^T J)^-1 scaled by the residual variance; 0 if fixed, NaN if undetermined
   bool fixed = false;
+  ParameterGroup group = ParameterGroup::kShape;  // which refine switch moves it
+  bool scale_like = false;                        // model/parameter_field.h
 };
 
 struct FitResult {
@@ -107,6 +81,12 @@ struct FitResult {
   // in it), in the units of `parameters`, rows in the order of covariance_names.
   Eigen::MatrixXd covariance;
   std::vector<std::string> covariance_names;
+  Eigen::MatrixXd correlation;  // of the covariance, same order
+  // Residual blocks and parameter blocks in the final problem (after outlier removal and
+  // gauge fixing): corners fitted, priors, and the blocks Ceres moved (poses included).
+  int residual_blocks = 0;
+  int free_parameter_blocks = 0;
+  int free_columns = 0;  // tangent-space size of those blocks
   // Parameters that ended more than 3 tolerances from their design values, one line each.
   std::vector<std::string> tolerance_conflicts;
   // How the tolerances were applied where that is not as given (ignored on a held
@@ -118,7 +98,8 @@ struct FitResult {
   double sigma_px = 0.0;
 };
 
-// The sensor's parameters in FitResult's naming and units (values only, std 0).
+// The sensor's parameters in FitResult's naming and units (values only, std 0), with
+// their groups.
 std::vector<ParameterEstimate> SensorParameters(const Sensor& sensor);
 // Tolerances per parameter name: the pairs (tilt_deg, decenter_mm, principal_point_px,
 // focal_px) expanded to their components, a component named on its own winning.

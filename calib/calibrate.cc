@@ -8,9 +8,11 @@
 #include <cstdio>
 
 #include "calib/board_scale.h"
+#include "calib/fit_covariance.h"
 #include "calib/image_file.h"
 #include "calib/rim_circle.h"
 #include "model/input_error.h"
+#include "model/model_registry.h"
 
 namespace omnical {
 namespace {
@@ -111,21 +113,14 @@ DetectedImages FindCorners(const CalibrationInput& input, const CalibrationOptio
   return found;
 }
 
-bool ShapeParameter(const std::string& name) {
-  return name == "A_mm" || name == "B_mm" || (name.size() >= 2 && name[0] == 'c' && std::isdigit(static_cast<unsigned char>(name[1])));
-}
-bool ScaleLike(const std::string& name) {
-  return name == "fx_px" || name == "fy_px" || name == "scale_px_per_mm" || name == "m_mm" || ShapeParameter(name);
-}
-
 // The fit's tolerances: the guess's (those that apply to the fitted family), then the
 // options' (which win), centred on the start's values.
 FitOptions FitOptionsFor(const CalibrationInput& input, const CalibrationOptions& options, const Sensor& start,
                          std::vector<CalibrationWarning>* warnings) {
   FitOptions fit = FitOptions::DefaultsFor(start);
-  fit.fixed.insert(options.fixed.begin(), options.fixed.end());
+  if (const std::string why = fit.refine.Hold(options.fixed); !why.empty()) throw InputError(why);
   fit.robust_loss_px = options.loss_px;
-  fit.max_iterations = options.max_iterations;
+  fit.solver.max_num_iterations = options.max_iterations;
   if (const std::string why = fit.Check(); !why.empty()) throw InputError(why);
   fit.tolerances = ExpandTolerances(input.guess_tolerances);
   for (auto it = fit.tolerances.begin(); it != fit.tolerances.end();) {
@@ -180,8 +175,9 @@ std::map<std::string, CalibrationRecord::Spread> LeaveOneOut(const Sensor& start
 }  // namespace
 
 std::string CalibrationOptions::Check() const {
-  static const std::set<std::string> kProfiles = {"", "sphere", "paraboloid", "polynomial", "hyperboloid"};
-  if (!kProfiles.count(profile)) return "profile: unknown mirror family '" + profile + "' (sphere, paraboloid, polynomial, hyperboloid)";
+  const std::vector<std::string> profiles = ProfileNames(false);
+  if (!profile.empty() && std::find(profiles.begin(), profiles.end(), profile) == profiles.end())
+    return "profile: unknown mirror family '" + profile + "' (" + JoinChoices(profiles) + ")";
   if (!(rim_field_deg > 10.0 && rim_field_deg < 170.0)) return "rim_field_deg: must lie in (10, 170) deg";
   if (!(loss_px >= 0.0 && std::isfinite(loss_px))) return "loss_px: must be >= 0 and finite";
   if (max_iterations < 1) return "max_iterations: must be >= 1";
@@ -222,7 +218,8 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   std::optional<Sensor> start_sensor;
   if (input.guess) {
     start_sensor = options.profile.empty() ? *input.guess : ConvertProfile(*input.guess, options.profile);
-    record.start = input.guess_name + (options.profile.empty() ? "" : " as a " + options.profile + " mirror");
+    const bool vowel = !options.profile.empty() && std::string("aeiou").find(options.profile[0]) != std::string::npos;
+    record.start = input.guess_name + (options.profile.empty() ? "" : (vowel ? " as an " : " as a ") + options.profile + " mirror");
   } else {
     if (!rim)
       throw InputError(InputMessage(input.source, "images", "no mirror rim circle found to start from; give a sensor guess"));
@@ -299,7 +296,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   record.unrefined_corners_left_out = unrefined;
   record.observations = fit.observations;
   record.solver_report = fit.solver_report;
-  record.fixed_blocks = fit_options.fixed;
+  record.fixed_blocks = fit_options.refine.HeldNames();
   record.robust_loss_px = fit_options.robust_loss_px;
   record.covariance_ok = fit.covariance_ok;
   record.detection_passes = refit_start ? options.detection_passes : 1;
@@ -310,23 +307,21 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   if (!fit.covariance_ok)
     warnings.push_back({WarningCode::kFreeGauge, "",
                         "the parameters are not all determined by the data (a free gauge): fix one with --fix"});
-  // Weakly determined: the "dolly zoom" between fx and m is the usual one (the lens sees
-  // the mirror under a small angle); fixing m from the design or fx from the lens helps.
-  // Only scale-like parameters have a meaningful relative std (tilts, decenters, the
-  // principal point and distortion are naturally near zero).
+  // Trust from the covariance (calib/fit_covariance.h): weakly determined scale-like
+  // parameters, named with the one they trade off with; the dolly-zoom block's condition.
+  std::vector<CovarianceParameter> free_parameters;
   for (const ParameterEstimate& p : fit.parameters)
-    if (!p.fixed && ScaleLike(p.name) && std::isfinite(p.std) && p.value != 0.0 && p.std > 0.05 * std::abs(p.value))
-      warnings.push_back({WarningCode::kWeaklyDetermined, p.name,
-                          p.name + " is weakly determined (std " + std::to_string(100.0 * p.std / std::abs(p.value)) +
-                              (p.name == "fx_px" || p.name == "fy_px" || p.name == "m_mm"
-                                   ? "% of its value): fx and m trade off; fix m from the design (--fix m) or the lens "
-                                     "scale, or add views at more distances"
-                                   : "% of its value): views covering more of the mirror, at more distances, help")});
+    if (!p.fixed && std::isfinite(p.std)) free_parameters.push_back({p.name, p.value, p.group, p.scale_like});
+  if (fit.covariance_ok && free_parameters.size() == fit.covariance_names.size()) {
+    record.scale_block_condition = ScaleBlockCondition(free_parameters, fit.covariance);
+    for (const CovarianceFinding& weak : WeakParameters(free_parameters, fit.covariance))
+      warnings.push_back({WarningCode::kWeaklyDetermined, weak.parameter, weak.text});
+  }
   // One distance: a non-central mirror's shape shows in how its image changes with the
   // object's distance (the viewpoints slide), so with every board at about the same range
   // the shape trades off against m and the lens scale.
   const bool shape_free = std::any_of(fit.parameters.begin(), fit.parameters.end(),
-                                      [&](const ParameterEstimate& p) { return !p.fixed && ShapeParameter(p.name); });
+                                      [&](const ParameterEstimate& p) { return !p.fixed && p.group == ParameterGroup::kShape; });
   double nearest_mm = HUGE_VAL, farthest_mm = 0.0;
   for (size_t v = 0; v < fit.poses.size(); ++v) {
     if (!fit.view_left_out[v].empty()) continue;  // its pose was not fitted
@@ -401,7 +396,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
         std::vector<std::string> help;
         if (farthest_mm < kOneDistanceRatio * nearest_mm) help.push_back("boards at other distances");
         const bool distortion_free = std::any_of(fit.parameters.begin(), fit.parameters.end(), [](const ParameterEstimate& p) {
-          return (p.name == "k1" || p.name == "k2") && !p.fixed;
+          return p.group == ParameterGroup::kDistortion && !p.fixed;
         });
         if (distortion_free) help.push_back("the distortion held (--fix distortion)");
         if (fit_options.tolerances.empty()) help.push_back("design tolerances (--tolerance)");

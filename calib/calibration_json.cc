@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "calib/fit_covariance.h"
 #include "calib/predicted_error.h"
 #include "model/io/atomic_write.h"
 #include "model/input_error.h"
@@ -59,6 +60,15 @@ json ToJson(const CalibrationRecord& r) {
       for (int col = 0; col < r.covariance.cols(); ++col) values[col] = r.covariance(row, col);
       j["covariance"]["matrix"].push_back(values);
     }
+    // The same as correlations (unit diagonal), for people reading the file.
+    const Eigen::MatrixXd correlation = CorrelationOf(r.covariance);
+    j["correlation"]["names"] = r.covariance_names;
+    for (int row = 0; row < correlation.rows(); ++row) {
+      std::vector<double> values(correlation.cols());
+      for (int col = 0; col < correlation.cols(); ++col) values[col] = correlation(row, col);
+      j["correlation"]["matrix"].push_back(values);
+    }
+    if (std::isfinite(r.scale_block_condition)) j["scale_block_condition"] = r.scale_block_condition;
   }
   for (const auto& p : r.predicted_error) {
     const bool infinite = p.distance_mm >= kInfinityMm;
@@ -132,6 +142,7 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
       for (int row = 0; row < size; ++row)
         for (int col = 0; col < size; ++col) r.covariance(row, col) = c.at("matrix").at(row).at(col).get<double>();
     }
+    if (j.contains("scale_block_condition")) r.scale_block_condition = at("scale_block_condition").get<double>();
     if (j.contains("predicted_error"))
       for (const json& p : at("predicted_error"))
         r.predicted_error.push_back({ReadDistance(p.at("distance_mm"), kInfinityMm), ReadDistance(p.at("n_rim_radii"), HUGE_VAL),

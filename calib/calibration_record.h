@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include <cmath>
 #include <map>
 #include <optional>
 #include <set>
@@ -44,6 +45,9 @@ struct CalibrationRecord {
   double guess_rim_radius_mm = 0.0, fitted_rim_radius_mm = 0.0;
   std::vector<std::string> covariance_names;  // empty unless covariance_ok
   Eigen::MatrixXd covariance;
+  // The condition number of the scale-like parameters' correlation matrix (lens focal, m,
+  // mirror size: the dolly-zoom valley); NaN without a covariance.
+  double scale_block_condition = NAN;
   struct PredictedErrorSummary {
     double distance_mm = 0.0;  // kInfinityMm (predicted_error.h) for infinity
     double n_rim_radii = 0.0;  // distance in the start's rim radii (HUGE_VAL for infinity)

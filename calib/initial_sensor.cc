@@ -2,7 +2,10 @@
 
 #include <ceres/ceres.h>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
+#include <type_traits>
 #include <variant>
 
 #include "model/input_error.h"
@@ -11,69 +14,56 @@ namespace omnical {
 
 namespace {
 
-// A mirror of family P from its parameters (the polynomial needs its count).
-template <template <typename> class P>
-struct Make {
-  template <typename T>
-  static P<T> From(const T* params, int /*count*/) { return P<T>::FromParams(params); }
-};
-template <>
-struct Make<EvenPolynomialProfile> {
-  template <typename T>
-  static EvenPolynomialProfile<T> From(const T* params, int count) {
-    return EvenPolynomialProfile<T>::FromParams(params, count);
-  }
-};
-
-// Sag (mm) and slope x rim radius (mm) of P against the sampled target.
-template <template <typename> class P>
+// Sag (mm) and slope x rim radius (mm) of a profile with these parameters against the
+// sampled target.
+template <typename Profile>
 struct SagResidual {
+  Profile shape;  // the family and its parameter count
   double r2, z_mm, slope_times_rim_mm, rim_mm;
-  int count;
   template <typename T>
-  bool operator()(const T* params, T* residual) const {
-    const SagDerivatives<T> g = Make<P>::template From<T>(params, count).EvaluateSag(T(r2));
+  bool operator()(T const* const* params, T* residual) const {
+    const SagDerivatives<T> g = shape.template WithParams<T>(params[0]).EvaluateSag(T(r2));
     residual[0] = g.z - T(z_mm);
     residual[1] = (T(2.0 * std::sqrt(r2)) * g.dz_ds) * T(rim_mm) - T(slope_times_rim_mm);
     return true;
   }
 };
 
-template <template <typename> class P, int N>
-std::vector<double> FitProfile(const std::vector<SagDerivatives<double>>& samples, const std::vector<double>& r2s,
-                               double rim_mm, std::vector<double> start, int count) {
+// The profile of start's family (and parameter count) nearest the samples.
+template <typename Profile>
+Profile FitProfile(const std::vector<SagDerivatives<double>>& samples, const std::vector<double>& r2s, double rim_mm,
+                   const Profile& start) {
+  std::vector<double> params(start.NumParams());
+  start.ToParams(params.data());
   ceres::Problem problem;
   for (size_t i = 0; i < samples.size(); ++i) {
-    auto* cost = new ceres::AutoDiffCostFunction<SagResidual<P>, 2, N>(new SagResidual<P>{
-        r2s[i], samples[i].z, 2.0 * std::sqrt(r2s[i]) * samples[i].dz_ds * rim_mm, rim_mm, count});
-    problem.AddResidualBlock(cost, nullptr, start.data());
+    auto* cost = new ceres::DynamicAutoDiffCostFunction<SagResidual<Profile>, 10>(new SagResidual<Profile>{
+        start, r2s[i], samples[i].z, 2.0 * std::sqrt(r2s[i]) * samples[i].dz_ds * rim_mm, rim_mm});
+    cost->AddParameterBlock(static_cast<int>(params.size()));
+    cost->SetNumResiduals(2);
+    problem.AddResidualBlock(cost, nullptr, params.data());
   }
   ceres::Solver::Options options;
   options.max_num_iterations = 200;
   options.function_tolerance = 1e-14;
   options.parameter_tolerance = 1e-14;
+  options.logging_type = ceres::SILENT;  // a library never prints
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
-  return start;
+  return start.WithParams(params.data());
 }
 
-// The guess's model with another mirror.
-template <template <typename> class P, typename Model>
-SensorModel WithMirror(const Model& model, const P<double>& mirror) {
-  auto copy = [&](auto out) -> SensorModel {
-    out.mirror = mirror;
-    out.lens = model.lens;
-    out.pose = model.pose;
-    out.rim_radius_mm = model.rim_radius_mm;
-    out.image_width_px = model.image_width_px;
-    out.image_height_px = model.image_height_px;
-    out.camera_body_radius_mm = model.camera_body_radius_mm;
-    return out;
-  };
-  if constexpr (Model::kOrthographic)
-    return copy(Catadioptric<double, P, OrthographicLens>{});
-  else
-    return copy(Catadioptric<double, P, PinholeLens>{});
+// The guess's model with another mirror (target: a model of that mirror and the same lens).
+template <typename Model, typename Target>
+SensorModel WithMirror(const Model& model, Target out, const typename Target::ProfileType& mirror) {
+  out.mirror = mirror;
+  out.lens = model.lens;
+  out.pose = model.pose;
+  out.rim_radius_mm = model.rim_radius_mm;
+  out.image_width_px = model.image_width_px;
+  out.image_height_px = model.image_height_px;
+  out.camera_body_radius_mm = model.camera_body_radius_mm;
+  return out;
 }
 
 Sensor Validated(SensorModel model, const std::string& what) {
@@ -105,22 +95,32 @@ Sensor SensorFromRimCircle(const RimCircle& rim, int image_width_px, int image_h
     EvenPolynomialProfile<double> polynomial;
     polynomial.num_coefficients = kDefaultPolynomialCoefficients;
     polynomial.coefficients[0] = 1.0 / (4.0 * base.mirror.focal_distance_mm);
-    return Validated(WithMirror<EvenPolynomialProfile>(base, polynomial), "rim circle");
+    return Validated(WithMirror(base, Catadioptric<double, EvenPolynomialProfile, OrthographicLens>{}, polynomial),
+                     "rim circle");
   }
   if (profile == "sphere") {
     // z = A - sqrt(A^2 - r^2): slope r / sqrt(A^2 - r^2).
-    return Validated(WithMirror<SphereProfile>(base, SphereProfile<double>{rim_mm * std::sqrt(1.0 + 1.0 / (slope * slope))}),
+    return Validated(WithMirror(base, Catadioptric<double, SphereProfile, OrthographicLens>{},
+                                SphereProfile<double>{rim_mm * std::sqrt(1.0 + 1.0 / (slope * slope))}),
                      "rim circle");
   }
-  throw InputError(InputMessage("profile", "", "'" + profile +
-                                                     "' cannot start from the rim circle alone (sphere, paraboloid or "
-                                                     "polynomial; a hyperboloid needs a guess with its design)"));
+  // Any other fitted family that can be smooth at the rim slope: the paraboloid re-expressed.
+  if (profile != "hyperboloid") {
+    const std::vector<std::string> fitted = ProfileNames(false);
+    if (std::find(fitted.begin(), fitted.end(), profile) != fitted.end()) return ConvertProfile(Sensor(base), profile);
+  }
+  std::vector<std::string> startable;
+  for (const std::string& name : ProfileNames(false))
+    if (name != "hyperboloid") startable.push_back(name);
+  throw InputError(InputMessage("profile", "", "'" + profile + "' cannot start from the rim circle alone (" +
+                                                     JoinChoices(startable) + "; a hyperboloid needs a guess with its design)"));
 }
 
 Sensor ConvertProfile(const Sensor& guess, const std::string& profile) {
   if (profile == guess.profile_name()) return guess;
-  if (profile != "sphere" && profile != "paraboloid" && profile != "polynomial" && profile != "hyperboloid")
-    throw InputError(InputMessage("profile", "", "unknown profile '" + profile + "' (sphere, paraboloid, polynomial, hyperboloid)"));
+  const std::vector<std::string> fitted = ProfileNames(false);
+  if (std::find(fitted.begin(), fitted.end(), profile) == fitted.end())
+    throw InputError(InputMessage("profile", "", "unknown profile '" + profile + "' (" + JoinChoices(fitted) + ")"));
   return std::visit(
       [&](const auto& model) -> Sensor {
         // Samples of the guess's sag and slope from the axis to the rim.
@@ -137,26 +137,18 @@ Sensor ConvertProfile(const Sensor& guess, const std::string& profile) {
         if (!(vertex_slope > 0.0))
           throw InputError(InputMessage("profile", "", "the guess's mirror is flat or concave at its vertex"));
         const double vertex_radius = 1.0 / (2.0 * vertex_slope);
-        if (profile == "paraboloid") {
-          const auto p = FitProfile<ParaboloidProfile, 1>(samples, r2s, rim, {vertex_radius / 2.0}, 1);
-          return Validated(WithMirror<ParaboloidProfile>(model, ParaboloidProfile<double>{p[0]}), "guess");
-        }
-        if (profile == "sphere") {
-          const auto p = FitProfile<SphereProfile, 1>(samples, r2s, rim, {std::max(vertex_radius, 1.05 * rim)}, 1);
-          return Validated(WithMirror<SphereProfile>(model, SphereProfile<double>{p[0]}), "guess");
-        }
-        if (profile == "hyperboloid") {
-          // z = (B / A) (sqrt(A^2 + r^2) - A): vertex radius A^2 / B; start with B = A.
-          const auto p = FitProfile<HyperboloidProfile, 2>(samples, r2s, rim, {vertex_radius, vertex_radius}, 2);
-          return Validated(WithMirror<HyperboloidProfile>(model, HyperboloidProfile<double>{p[0], p[1]}), "guess");
-        }
-        std::vector<double> start(kDefaultPolynomialCoefficients, 0.0);
-        start[0] = vertex_slope;
-        const auto p = FitProfile<EvenPolynomialProfile, kDefaultPolynomialCoefficients>(samples, r2s, rim, start,
-                                                                                         kDefaultPolynomialCoefficients);
-        return Validated(WithMirror<EvenPolynomialProfile>(
-                             model, EvenPolynomialProfile<double>::FromParams(p.data(), kDefaultPolynomialCoefficients)),
-                         "guess");
+        std::optional<Sensor> converted;
+        ForEachModelType([&](auto tag) {
+          using Target = typename decltype(tag)::type;
+          using Profile = typename Target::ProfileType;
+          using Model = std::decay_t<decltype(model)>;
+          if constexpr (kFittedProfile<Profile> && std::is_same_v<typename Target::LensType, typename Model::LensType>) {
+            if (converted || profile != Profile::kName) return;
+            const Profile start = Profile::FromVertexRadius(vertex_radius, rim);
+            converted = Validated(WithMirror(model, Target{}, FitProfile(samples, r2s, rim, start)), "guess");
+          }
+        });
+        return *converted;
       },
       guess.model());
 }

@@ -109,6 +109,7 @@ void Solve(ceres::Problem* problem) {
   options.function_tolerance = 1e-14;
   options.parameter_tolerance = 1e-14;
   options.gradient_tolerance = 1e-14;
+  options.logging_type = ceres::SILENT;  // a library never prints
   ceres::Solver::Summary summary;
   ceres::Solve(options, problem, &summary);
 }

@@ -1,14 +1,16 @@
 // Lenses looking at the mirror, in the camera frame (model/types.h).
 //
-// How to add a lens: a struct template over T with kName, kNumParams, kParamsInfo,
-// kIsOrthographic, ProjectToPixel, PixelToRay, CheckDomain, Cast, FromParams/ToParams.
+// Every lens has the interface listed at the top of model/model_registry.h, where lenses
+// are registered (how to add one is written there).
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 #include <type_traits>
 
+#include "model/parameter_field.h"
 #include "model/scalar.h"
 #include "model/types.h"
 
@@ -22,7 +24,13 @@ template <typename T>
 struct PinholeLens {
   static constexpr const char* kName = "pinhole";
   static constexpr int kNumParams = 6;
-  static constexpr const char* kParamsInfo = "fx_px, fy_px, cx_px, cy_px, k1, k2";
+  static constexpr std::array<ParameterField, kNumParams> kFields{
+      {ScalarField("fx", "fx_px", ParameterGroup::kFocal, true, FieldDomain::kPositive, 1e8),
+       ScalarField("fy", "fy_px", ParameterGroup::kFocal, true, FieldDomain::kPositive, 1e8),
+       ScalarField("cx", "cx_px", ParameterGroup::kPrincipalPoint, false, FieldDomain::kBounded, 1e7),
+       ScalarField("cy", "cy_px", ParameterGroup::kPrincipalPoint, false, FieldDomain::kBounded, 1e7),
+       ScalarField("k1", "k1", ParameterGroup::kDistortion, false, FieldDomain::kBounded, 1e6, 0, true),
+       ScalarField("k2", "k2", ParameterGroup::kDistortion, false, FieldDomain::kBounded, 1e6, 0, true)}};
   static constexpr bool kIsOrthographic = false;
   T fx_px, fy_px, cx_px, cy_px, k1, k2;
 
@@ -90,6 +98,7 @@ struct PinholeLens {
 
   std::string CheckDomain() const {
     if (!(ScalarPart(fx_px) > 0.0) || !(ScalarPart(fy_px) > 0.0)) return "fx and fy must be > 0";
+    if (ScalarPart(fx_px) < 1e-3 || ScalarPart(fy_px) < 1e-3) return "fx: focal lengths below 1e-3 px are not a camera";
     return {};
   }
   template <typename U>
@@ -109,7 +118,10 @@ template <typename T>
 struct OrthographicLens {
   static constexpr const char* kName = "orthographic";
   static constexpr int kNumParams = 3;
-  static constexpr const char* kParamsInfo = "scale_px_per_mm, cx_px, cy_px";
+  static constexpr std::array<ParameterField, kNumParams> kFields{
+      {ScalarField("scale_px_per_mm", "scale_px_per_mm", ParameterGroup::kFocal, true, FieldDomain::kPositive, 1e6),
+       ScalarField("cx", "cx_px", ParameterGroup::kPrincipalPoint, false, FieldDomain::kBounded, 1e7),
+       ScalarField("cy", "cy_px", ParameterGroup::kPrincipalPoint, false, FieldDomain::kBounded, 1e7)}};
   static constexpr bool kIsOrthographic = true;
   T scale_px_per_mm, cx_px, cy_px;
 

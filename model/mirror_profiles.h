@@ -5,25 +5,17 @@
 // (tilted) solver can use dz/dx = 2 x g'(s) everywhere. Derivatives along the radius
 // follow: f' = 2 r g', f'' = 2 g' + 4 r^2 g''.
 //
-// How to add a profile:
-//  1. A struct template over the scalar T holding its parameters as T (so ceres::Jet
-//     parameters flow through), with kName, kNumParams and kParamsInfo.
-//  2. template <typename S> SagDerivatives<S> EvaluateSag(const S& r2) const returning
-//     g, g', g'' at s = r2. S may differ from T only when T is double (the solvers
-//     evaluate with S = Jet to get curvature derivatives).
-//  3. std::string CheckDomain(double rim_radius_mm) const: empty if the parameters are
-//     valid up to the rim, else a one-line reason (shown to the user).
-//  4. double MaxRadiusMm() const: where the formula stops being defined (infinity if
-//     never); solvers keep their iterates inside it.
-//  5. template <typename U> Cast() const, and FromParams / ToParams.
-//  6. Add it to SensorModel in sensor.h and to the YAML reader in sensor_yaml.cc;
-//     the templated tests in tests/projection_test.cc then cover it.
+// Every profile has the interface listed at the top of model/model_registry.h, where
+// profiles are registered (how to add one is written there).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string>
 
+#include "model/parameter_field.h"
 #include "model/scalar.h"
 
 namespace omnical {
@@ -48,9 +40,15 @@ inline void RadialSlopes(const SagDerivatives<S>& g, const S& r, S* dz_dr, S* d2
 template <typename T>
 struct SphereProfile {
   static constexpr const char* kName = "sphere";
-  static constexpr int kNumParams = 1;
-  static constexpr const char* kParamsInfo = "A_mm";
+  static constexpr int kRimSlopeParam = 0;  // the one the design fit solves for
+  static constexpr std::array<ParameterField, 1> kFields{
+      {ScalarField("A", "A_mm", ParameterGroup::kShape, true, FieldDomain::kPositive, 1e7, 1)}};
+  static constexpr int kMaxParams = 1;
+  // Turned about its own centre a sphere is the same surface: its tilt is its gauge.
+  static constexpr bool kTiltObservable = false;
   T radius_of_curvature_mm;
+
+  int NumParams() const { return 1; }
 
   template <typename S>
   SagDerivatives<S> EvaluateSag(const S& r2) const {
@@ -71,8 +69,19 @@ struct SphereProfile {
   SphereProfile<U> Cast() const {
     return {CastScalar<U>(radius_of_curvature_mm)};
   }
-  static SphereProfile FromParams(const T* params) { return {params[0]}; }
+  static SphereProfile FromParams(const T* params, int /*count*/ = 1) { return {params[0]}; }
   void ToParams(T* params) const { params[0] = radius_of_curvature_mm; }
+  template <typename U>
+  SphereProfile<U> WithParams(const U* params) const { return {params[0]}; }
+  static SphereProfile FromVertexRadius(double vertex_radius_mm, double rim_mm) {
+    return {T(std::max(vertex_radius_mm, 1.05 * rim_mm))};
+  }
+  // f'(1) = 1 / sqrt(A^2 - 1) at the normalised rim.
+  template <typename U>
+  static void SolveRimSlope(U* params, int /*count*/, const U& slope) {
+    using std::sqrt;
+    params[0] = sqrt(U(1.0) + U(1.0) / (slope * slope));
+  }
 };
 
 // Even polynomial z = sum_k c_k r^(2k), k = 1..n (the seed's "equidistant" E-DI
@@ -80,8 +89,13 @@ struct SphereProfile {
 template <typename T>
 struct EvenPolynomialProfile {
   static constexpr const char* kName = "polynomial";
+  static constexpr int kRimSlopeParam = 0;  // the one the design fit solves for
   static constexpr int kMaxCoefficients = 8;
-  static constexpr const char* kParamsInfo = "c1_per_mm, c2_per_mm3, ...";
+  // c_k in mm^(1-2k): c1 per mm, c2 per mm^3, ...
+  static constexpr std::array<ParameterField, 1> kFields{
+      {TermList("coefficients", "c", 1, kMaxCoefficients, 1, 1, -1, -2, std::numeric_limits<double>::infinity(), true)}};
+  static constexpr int kMaxParams = kMaxCoefficients;
+  static constexpr bool kTiltObservable = true;
   std::array<T, kMaxCoefficients> coefficients{};
   int num_coefficients = 0;
 
@@ -120,6 +134,22 @@ struct EvenPolynomialProfile {
   void ToParams(T* params) const {
     for (int k = 0; k < num_coefficients; ++k) params[k] = coefficients[k];
   }
+  template <typename U>
+  EvenPolynomialProfile<U> WithParams(const U* params) const {
+    return EvenPolynomialProfile<U>::FromParams(params, num_coefficients);
+  }
+  // The parabola of that vertex radius, c1 = 1 / (2 R), and two more terms at 0.
+  static EvenPolynomialProfile FromVertexRadius(double vertex_radius_mm, double /*rim_mm*/) {
+    const T start[3] = {T(0.5 / vertex_radius_mm), T(0.0), T(0.0)};
+    return FromParams(start, 3);
+  }
+  // f'(1) = sum 2k c_k, solved for c1.
+  template <typename U>
+  static void SolveRimSlope(U* params, int count, const U& slope) {
+    U rest(0.0);
+    for (int k = 1; k < count; ++k) rest += U(2.0 * (k + 1)) * params[k];
+    params[0] = U(0.5) * (slope - rest);
+  }
 };
 
 // Hyperboloid sheet with vertex at the origin (seed Table 1, corrected):
@@ -129,10 +159,16 @@ struct EvenPolynomialProfile {
 template <typename T>
 struct HyperboloidProfile {
   static constexpr const char* kName = "hyperboloid";
-  static constexpr int kNumParams = 2;
-  static constexpr const char* kParamsInfo = "A_mm, B_mm";
+  static constexpr int kRimSlopeParam = 1;  // the one the design fit solves for
+  static constexpr std::array<ParameterField, 2> kFields{
+      {ScalarField("A", "A_mm", ParameterGroup::kShape, true, FieldDomain::kPositive, 1e7, 1),
+       ScalarField("B", "B_mm", ParameterGroup::kShape, true, FieldDomain::kPositive, 1e7, 1)}};
+  static constexpr int kMaxParams = 2;
+  static constexpr bool kTiltObservable = true;
   T a_mm;
   T b_mm;
+
+  int NumParams() const { return 2; }
 
   template <typename S>
   SagDerivatives<S> EvaluateSag(const S& r2) const {
@@ -152,10 +188,22 @@ struct HyperboloidProfile {
   HyperboloidProfile<U> Cast() const {
     return {CastScalar<U>(a_mm), CastScalar<U>(b_mm)};
   }
-  static HyperboloidProfile FromParams(const T* params) { return {params[0], params[1]}; }
+  static HyperboloidProfile FromParams(const T* params, int /*count*/ = 2) { return {params[0], params[1]}; }
   void ToParams(T* params) const {
     params[0] = a_mm;
     params[1] = b_mm;
+  }
+  template <typename U>
+  HyperboloidProfile<U> WithParams(const U* params) const { return {params[0], params[1]}; }
+  // Vertex radius of curvature A^2 / B: with A = B = R.
+  static HyperboloidProfile FromVertexRadius(double vertex_radius_mm, double /*rim_mm*/) {
+    return {T(vertex_radius_mm), T(vertex_radius_mm)};
+  }
+  // f'(1) = (B / A) / sqrt(A^2 + 1), solved for B.
+  template <typename U>
+  static void SolveRimSlope(U* params, int /*count*/, const U& slope) {
+    using std::sqrt;
+    params[1] = params[0] * sqrt(params[0] * params[0] + U(1.0)) * slope;
   }
 };
 
@@ -164,9 +212,14 @@ struct HyperboloidProfile {
 template <typename T>
 struct ParaboloidProfile {
   static constexpr const char* kName = "paraboloid";
-  static constexpr int kNumParams = 1;
-  static constexpr const char* kParamsInfo = "A_mm (focal distance)";
+  static constexpr int kRimSlopeParam = 0;  // the one the design fit solves for
+  static constexpr std::array<ParameterField, 1> kFields{
+      {ScalarField("A", "A_mm", ParameterGroup::kShape, true, FieldDomain::kPositive, 1e7, 1)}};
+  static constexpr int kMaxParams = 1;
+  static constexpr bool kTiltObservable = true;
   T focal_distance_mm;
+
+  int NumParams() const { return 1; }
 
   template <typename S>
   SagDerivatives<S> EvaluateSag(const S& r2) const {
@@ -182,8 +235,19 @@ struct ParaboloidProfile {
   ParaboloidProfile<U> Cast() const {
     return {CastScalar<U>(focal_distance_mm)};
   }
-  static ParaboloidProfile FromParams(const T* params) { return {params[0]}; }
+  static ParaboloidProfile FromParams(const T* params, int /*count*/ = 1) { return {params[0]}; }
   void ToParams(T* params) const { params[0] = focal_distance_mm; }
+  template <typename U>
+  ParaboloidProfile<U> WithParams(const U* params) const { return {params[0]}; }
+  // Vertex radius of curvature 2 A.
+  static ParaboloidProfile FromVertexRadius(double vertex_radius_mm, double /*rim_mm*/) {
+    return {T(0.5 * vertex_radius_mm)};
+  }
+  // f'(1) = 1 / (2 A).
+  template <typename U>
+  static void SolveRimSlope(U* params, int /*count*/, const U& slope) {
+    params[0] = U(0.5) / slope;
+  }
 };
 
 }  // namespace omnical

@@ -1,5 +1,5 @@
-// The run-time sensor: one of the compile-time Catadioptric combinations, chosen by the
-// sensor file, plus the precomputation for fast batch projection. The variant is for
+// The run-time sensor: one of the compile-time Catadioptric combinations of the registry
+// (model/model_registry.h), chosen by the sensor file, plus the precomputation for fast batch projection. The variant is for
 // I/O and the CLI; hot loops visit once and then run the concrete type.
 #pragma once
 
@@ -8,20 +8,9 @@
 #include <variant>
 #include <vector>
 
-#include "model/catadioptric.h"
-#include "model/tabulated_profile.h"
+#include "model/model_registry.h"
 
 namespace omnical {
-
-using SensorModel = std::variant<
-    Catadioptric<double, SphereProfile, PinholeLens>, Catadioptric<double, EvenPolynomialProfile, PinholeLens>,
-    Catadioptric<double, HyperboloidProfile, PinholeLens>, Catadioptric<double, ParaboloidProfile, PinholeLens>,
-    Catadioptric<double, TabulatedProfile, PinholeLens>,
-    Catadioptric<double, SphereProfile, OrthographicLens>,
-    Catadioptric<double, EvenPolynomialProfile, OrthographicLens>,
-    Catadioptric<double, HyperboloidProfile, OrthographicLens>,
-    Catadioptric<double, ParaboloidProfile, OrthographicLens>,
-    Catadioptric<double, TabulatedProfile, OrthographicLens>>;
 
 class Sensor {
  public:

@@ -16,6 +16,7 @@
 // The table is data, not a parameter: it is never refined by calibration.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -88,10 +89,20 @@ class ProfileSpline {
 template <typename T>
 struct TabulatedProfile {
   static constexpr const char* kName = "tabulated";
-  static constexpr int kNumParams = 0;
-  static constexpr const char* kParamsInfo = "";
+  // No parameter: the shape is the table (mirror.table in the sensor file), never fitted.
+  static constexpr std::array<ParameterField, 0> kFields{};
+  static constexpr int kMaxParams = 0;
+  static constexpr int kRimSlopeParam = -1;  // not a design family
+  static constexpr bool kTiltObservable = true;
   std::shared_ptr<const ProfileSpline> spline;
   std::string source;  // the CSV it came from, written back by the sensor writer
+
+  int NumParams() const { return 0; }
+  void ToParams(T* /*params*/) const {}
+  template <typename U>
+  TabulatedProfile<U> WithParams(const U* /*params*/) const {
+    return Cast<U>();
+  }
 
   template <typename S>
   SagDerivatives<S> EvaluateSag(const S& r2) const {

@@ -44,4 +44,13 @@ run design fit --profile sphere --rim-omega 135 --rim-theta 12 --out "$out/desig
 run design fit --profile hyperboloid --characteristic svp --out "$out/design-fit-svp"
 run design fit --profile polynomial --characteristic equidistant --compare "$data/sensors/ohte-edi.yaml" --out "$out/design-fit-edi"
 run render --scene "$data/scenes/ohte-sph-misaligned-near.yaml" --out "$out/render-misaligned"
+# The real dev set (../shared/real-data, beside the checkout), when present: from the
+# images alone and from the two hand-made guesses.
+real=$root/../shared/real-data/mei-parabolic
+if [ -d "$real" ]; then
+  board=$root/tests/data/mei-parabolic-checkerboard.yaml
+  run calibrate --target "$board" --images "$real" --threads 2 --out "$out/calibrate-real"
+  run calibrate --target "$board" --images "$real" --sensor "$root/tests/data/mei-parabolic-guess.yaml" --threads 2 --out "$out/calibrate-real-paraboloid"
+  run calibrate --target "$board" --images "$real" --sensor "$root/tests/data/mei-parabolic-polynomial-guess.yaml" --threads 2 --out "$out/calibrate-real-polynomial"
+fi
 echo "reference outputs in $out"

@@ -189,7 +189,7 @@ void NoisyFitHolds(bool with_outliers) {
     // the lens sees the mirror under a small angle, so backing off while zooming in leaves
     // the image almost unchanged) that 0.5 px of noise cannot resolve: a fit started at
     // the truth drifts ~25% along it at the same RMS, which no linearised std describes.
-    options.fixed.insert("m");
+    options.refine.m = false;
     if (!with_outliers) options.robust_loss_px = 0.0;  // Gaussian noise: plain least squares
     const FitResult fit = FitSensor(guess, truth.target, noisy, poses, options);
     ASSERT_TRUE(fit.covariance_ok) << "seed " << seed;
@@ -221,12 +221,27 @@ TEST(BundleFit, StandardDeviationsHoldUnderNoise) { NoisyFitHolds(false); }
 // fit finds exactly them and the rest holds.
 TEST(BundleFit, StandardDeviationsHoldWithGrossOutliers) { NoisyFitHolds(true); }
 
-TEST(FitOptions, RejectsUnknownBlocks) {
+TEST(RefineOptions, HoldsBlocksByTheirNamesAndRejectsUnknownOnes) {
+  RefineOptions refine;
+  EXPECT_NE(refine.Hold({"lens", "focal"}).find("unknown block 'focal'"), std::string::npos);
+  refine = RefineOptions();
+  EXPECT_EQ(refine.Hold({"lens", "m"}), "");
+  EXPECT_FALSE(refine.focal || refine.principal_point || refine.distortion || refine.m);
+  EXPECT_TRUE(refine.tilt && refine.decenter && refine.shape && refine.poses);
+  EXPECT_EQ(refine.HeldNames(), (std::set<std::string>{"lens", "m"}));
+  refine = RefineOptions();
+  EXPECT_EQ(refine.Hold({"principal_point", "distortion"}), "");
+  EXPECT_EQ(refine.HeldNames(), (std::set<std::string>{"distortion", "principal_point"}));
+}
+
+TEST(FitOptions, CheckRefusesInvalidSolverSettings) {
   FitOptions options;
-  options.fixed = {"lens", "focal"};
-  EXPECT_NE(options.Check().find("unknown block 'focal'"), std::string::npos);
-  options.fixed = {"lens", "m"};
   EXPECT_EQ(options.Check(), "");
+  options.solver.max_num_iterations = 0;
+  EXPECT_EQ(options.Check(), "max_iterations: must be >= 1");
+  options = FitOptions();
+  options.solver.function_tolerance = -1.0;
+  EXPECT_EQ(options.Check().rfind("solver: ", 0), 0u) << options.Check();
 }
 
 }  // namespace

@@ -40,7 +40,7 @@ ProgressCallback StopAt(const std::string& stage, std::string* stages_seen) {
 // of the last one), for Omega 135 / Theta 12 deg at the rim.
 TEST(DesignFitJob, SphereReproducesTable1) {
   DesignFitOptions options;
-  options.spec.family = ProfileFamily::kSphere;
+  options.spec.profile = "sphere";
   options.spec.rim_omega_deg = 135.0;
   options.spec.rim_theta_deg = 12.0;
   ASSERT_EQ(options.Check(), "");
@@ -60,7 +60,7 @@ TEST(DesignFitJob, SphereReproducesTable1) {
 
 TEST(DesignFitJob, CheckNamesTheField) {
   DesignFitOptions options;
-  options.spec.family = ProfileFamily::kSphere;
+  options.spec.profile = "sphere";
   options.spec.rim_omega_deg = 10.0;  // below Theta
   EXPECT_TRUE(StartsWith(options.Check(), "rim_omega_deg:")) << options.Check();
   try {
@@ -73,17 +73,17 @@ TEST(DesignFitJob, CheckNamesTheField) {
   options.rim_radius_mm = -1.0;
   EXPECT_TRUE(StartsWith(options.Check(), "rim_radius_mm:")) << options.Check();
   options.rim_radius_mm = 43.9;
-  options.spec.family = ProfileFamily::kPolynomial;
-  options.spec.polynomial_terms = 9;
-  EXPECT_TRUE(StartsWith(options.Check(), "polynomial_terms:")) << options.Check();
+  options.spec.profile = "polynomial";
+  options.spec.terms = 9;
+  EXPECT_TRUE(StartsWith(options.Check(), "terms:")) << options.Check();
 }
 
 // A callback returning false during the Ceres solve stops it after that iteration:
 // Cancelled, no result.
 TEST(DesignFitJob, CallbackReturningFalseCancelsTheFit) {
   DesignFitOptions options;
-  options.spec.family = ProfileFamily::kPolynomial;
-  options.spec.characteristic = DefaultCharacteristic(ProfileFamily::kPolynomial, 3);
+  options.spec.profile = "polynomial";
+  options.spec.characteristic = DefaultCharacteristic("polynomial", 3);
   long last_fit_report = -1;
   options.progress = [&last_fit_report](const ProgressUpdate& update) {
     if (update.stage == "fit") last_fit_report = update.done;

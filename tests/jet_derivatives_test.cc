@@ -19,11 +19,7 @@ using Jet = ceres::Jet<double, kMaxParams>;
 
 template <typename T, template <typename> class Profile>
 int ProfileParamCount(const Profile<T>& profile) {
-  if constexpr (std::is_same_v<Profile<T>, EvenPolynomialProfile<T>>) {
-    return profile.NumParams();
-  } else {
-    return Profile<T>::kNumParams;
-  }
+  return profile.NumParams();
 }
 
 // Flattens [profile, lens, pose, point] and rebuilds a model of any scalar from them.
@@ -34,7 +30,7 @@ struct Packed {
 
   std::vector<double> Flatten(const Eigen::Vector3d& point) const {
     std::vector<double> values(kMaxParams, 0.0);
-    if constexpr (!std::is_same_v<Profile<double>, TabulatedProfile<double>>) base.mirror.ToParams(values.data());
+    base.mirror.ToParams(values.data());
     base.lens.ToParams(values.data() + num_profile);
     base.pose.ToParams(values.data() + num_profile + Lens<double>::kNumParams);
     for (int k = 0; k < 3; ++k) values[num_profile + Lens<double>::kNumParams + 5 + k] = point[k];
@@ -45,13 +41,7 @@ struct Packed {
   template <typename T>
   ProjectionStatus Project(const std::vector<T>& values, Vec2<T>* pixel) const {
     Catadioptric<T, Profile, Lens> model;
-    if constexpr (std::is_same_v<Profile<double>, TabulatedProfile<double>>) {
-      model.mirror = base.mirror.template Cast<T>();
-    } else if constexpr (std::is_same_v<Profile<double>, EvenPolynomialProfile<double>>) {
-      model.mirror = Profile<T>::FromParams(values.data(), num_profile);
-    } else {
-      model.mirror = Profile<T>::FromParams(values.data());
-    }
+    model.mirror = base.mirror.template WithParams<T>(values.data());
     model.lens = Lens<T>::FromParams(values.data() + num_profile);
     model.pose = MirrorPose<T>::FromParams(values.data() + num_profile + Lens<double>::kNumParams);
     model.rim_radius_mm = base.rim_radius_mm;

@@ -75,6 +75,12 @@ std::vector<NamedSensor> SensorsWithLens(const std::string& lens_name, bool misa
        MakeModel<HyperboloidProfile, Lens>({0.7407 * kRimMm, 1.698 * kRimMm}, 3.550 * kRimMm, misaligned)},
       {"paraboloid" + suffix, MakeModel<ParaboloidProfile, Lens>({0.5 * kRimMm}, m, misaligned)},
       {"tabulated" + suffix, MakeModel<TabulatedProfile, Lens>(SampledEdiProfile(), 3.919 * kRimMm, misaligned)},
+      // A hyperbolic conic (k = -1.5) with two even terms: every part of the formula used.
+      {"even_asphere" + suffix, MakeModel<EvenAsphereProfile, Lens>(
+                                    EvenAsphereProfile<double>::FromParams(
+                                        std::vector<double>{0.9 * kRimMm, -1.5, 0.02 / std::pow(kRimMm, 3),
+                                                            -0.004 / std::pow(kRimMm, 5)}.data(), 4),
+                                    3.6 * kRimMm, misaligned)},
   };
 }
 
@@ -85,6 +91,20 @@ inline std::vector<NamedSensor> AllTestSensors() {
     for (auto& s : SensorsWithLens<OrthographicLens>("orthographic", misaligned)) all.push_back(std::move(s));
   }
   return all;
+}
+
+// Whether every model type of the registry (model/model_registry.h) has an aligned and a
+// misaligned test sensor: a profile registered without one fails ModelRegistry tests.
+inline std::string ModelTypesWithoutTestSensor() {
+  const std::vector<NamedSensor> all = AllTestSensors();
+  std::string missing;
+  ForEachModelType([&](auto tag) {
+    using Model = typename decltype(tag)::type;
+    int count = 0;
+    for (const NamedSensor& s : all) count += std::holds_alternative<Model>(s.model);
+    if (count < 2) missing += std::string(Model::ProfileType::kName) + "/" + Model::LensType::kName + " ";
+  });
+  return missing;
 }
 
 inline std::string SourceDir() { return OMNICAL_SOURCE_DIR; }

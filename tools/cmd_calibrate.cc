@@ -11,6 +11,7 @@
 #include "calib/image_file.h"
 #include "calib/report/calibration_report.h"
 #include "model/io/atomic_write.h"
+#include "model/model_registry.h"
 #include "tools/commands.h"
 #include "tools/progress.h"
 #include "model/io/sensor_yaml.h"
@@ -94,16 +95,17 @@ Command CalibrateCommand() {
                            "Sensor guess (YAML): nominal design values. Without it the fit starts from the mirror's "
                            "rim circle in the images (orthographic lens, scale held)");
             sub.add_option("--profile", library.profile,
-                           "Mirror family to fit: sphere, paraboloid, polynomial (default without a guess), hyperboloid "
-                           "(needs --sensor); a guess of another family is converted")
-                ->check(CLI::IsMember({"sphere", "paraboloid", "polynomial", "hyperboloid"}));
+                           "Mirror family to fit: " + JoinChoices(ProfileNames(false)) +
+                               " (polynomial by default without a guess; a hyperboloid needs --sensor); a guess of "
+                               "another family is converted")
+                ->check(CLI::IsMember(ProfileNames(false)));
             sub.add_option("--rim-field-deg", library.rim_field_deg,
                            "Without a guess: the rim ray's angle from the mirror axis (Omega, deg) to start from")
                 ->check(CLI::Range(10.0, 170.0))->capture_default_str();
             library.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
             sub.add_option("--threads", library.threads, "Detection threads")->check(CLI::Range(1, 256))->capture_default_str();
             sub.add_option("--out", options->out_dir, "Output directory")->required();
-            sub.add_option("--fix", options->fix, "Blocks held constant: lens, lens_scale, distortion, m, tilt, decenter, shape, poses");
+            sub.add_option("--fix", options->fix, "Blocks held constant: lens, lens_scale, principal_point, distortion, m, tilt, decenter, shape, poses");
             sub.add_option("--loss-px", library.loss_px, "Huber loss scale, px (0: least squares)")
                 ->check(CLI::Range(0.0, 1000.0))->capture_default_str();
             sub.add_option("--max-iterations", library.max_iterations, "Solver iterations per stage")

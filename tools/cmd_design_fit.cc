@@ -15,16 +15,17 @@
 #include "tools/field_flags.h"
 #include "tools/progress.h"
 #include "model/io/sensor_yaml.h"
+#include "model/model_registry.h"
 
 namespace omnical::cli {
 
 void AddDesignFitOptions(CLI::App* fit, DesignFitFlags* f) {
   DesignFitOptions& o = f->job;
-  fit->add_option("--profile", f->profile, "Profile family: sphere, polynomial or hyperboloid")
+  fit->add_option("--profile", f->profile, "Profile family: " + JoinChoices(DesignProfileNames()))
       ->required()
-      ->check(CLI::IsMember({"sphere", "polynomial", "hyperboloid"}));
-  fit->add_option("--terms", o.spec.polynomial_terms, "polynomial: even terms c1 x^2 .. cn x^2n")
-      ->check(CLI::Range(1, 8))
+      ->check(CLI::IsMember(DesignProfileNames()));
+  fit->add_option("--terms", o.spec.terms, "How many terms the family's list has: " + DesignTermsHelp())
+      ->check(CLI::Range(0, 8))
       ->capture_default_str();
   fit->add_option("--rim-omega", o.spec.rim_omega_deg,
                   "Omega at the rim: the object ray's angle from the -z axis (deg)")
@@ -32,8 +33,8 @@ void AddDesignFitOptions(CLI::App* fit, DesignFitFlags* f) {
   fit->add_option("--rim-theta", o.spec.rim_theta_deg, "Theta at the rim: the lens's viewing angle (deg)")
       ->capture_default_str();
   fit->add_option("--characteristic", f->characteristic,
-                  "equidistant, svp, aspect or area (default: polynomial equidistant, hyperboloid svp; a sphere has no "
-                  "freedom left)")
+                  "equidistant, svp, aspect or area (default: svp for a hyperboloid, equidistant for a family with "
+                  "freedom left after the rim targets)")
       ->check(CLI::IsMember({"equidistant", "svp", "aspect", "area"}));
   fit->add_option("--rim-radius-mm", o.rim_radius_mm, "Mirror radius M at the rim (mm): scales the normalised design")
       ->check(kPositive)
@@ -47,10 +48,8 @@ void AddDesignFitOptions(CLI::App* fit, DesignFitFlags* f) {
 
 void RunDesignFit(DesignFitFlags& f, const Context& context) {
   DesignFitOptions& o = f.job;
-  o.spec.family = f.profile == "sphere"        ? ProfileFamily::kSphere
-                  : f.profile == "hyperboloid" ? ProfileFamily::kHyperboloid
-                                               : ProfileFamily::kPolynomial;
-  o.spec.characteristic = DefaultCharacteristic(o.spec.family, o.spec.polynomial_terms);
+  o.spec.profile = f.profile;
+  o.spec.characteristic = DefaultCharacteristic(o.spec.profile, o.spec.terms);
   for (ImageCharacteristic c : {ImageCharacteristic::kEquidistant, ImageCharacteristic::kSingleViewpoint,
                                 ImageCharacteristic::kConstantAspect, ImageCharacteristic::kEqualArea})
     if (f.characteristic == CharacteristicName(c)) o.spec.characteristic = c;
@@ -65,7 +64,7 @@ void RunDesignFit(DesignFitFlags& f, const Context& context) {
   }
   const FlagTable flags = {{"rim_omega_deg", "--rim-omega"},
                             {"rim_theta_deg", "--rim-theta"},
-                            {"polynomial_terms", "--terms"},
+                            {"terms", "--terms"},
                             {"rim_radius_mm", "--rim-radius-mm"},
                             {"image_size_px", "--image-size"}};
   o.progress = TerminalProgress(context);
@@ -80,7 +79,7 @@ void RunDesignFit(DesignFitFlags& f, const Context& context) {
   WriteFitDesignJson(r, "sensor.yaml", (dir / "design.json").string());
 
   if (!context.quiet) {
-    std::printf("%s:", ProfileFamilyName(r.spec.family));
+    std::printf("%s:", r.spec.profile.c_str());
     for (const auto& [name, value] : NormalisedParameters(r.design)) std::printf(" %s = %.6g", name.c_str(), value);
     std::printf(" (normalised); rim Omega %.4f, Theta %.4f deg", r.achieved.rim_omega_deg, r.achieved.rim_theta_deg);
     if (r.law == r.spec.characteristic)

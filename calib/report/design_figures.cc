@@ -86,7 +86,7 @@ void WriteFitDesignFigures(const DesignFitResult& r, const std::string& dir) {
   char lens_note[160];
   std::snprintf(lens_note, sizeof lens_note, "Lens principal point on the axis %.3f mm below the vertex (m).",
                 r.design.m * r.rim_radius_mm);
-  drawing.title = std::string("omnical design fit: ") + ProfileFamilyName(spec.family) +
+  drawing.title = std::string("omnical design fit: ") + spec.profile +
                   (spec.characteristic == ImageCharacteristic::kNone
                        ? std::string()
                        : std::string(", ") + CharacteristicName(spec.characteristic)) +
@@ -100,7 +100,7 @@ void WriteFitDesignFigures(const DesignFitResult& r, const std::string& dir) {
   PlotPanel height("Image height h vs Omega (seed Fig. 5)", "Omega (deg)", "h (px)");
   PlotPanel deviation(std::string("Departure from the ") + CharacteristicName(r.law) + " law", "Omega (deg)",
                       "h - h_law (px)");
-  height.series.push_back(Curve("fitted " + std::string(ProfileFamilyName(spec.family)), r.achieved, 0, false, r.law));
+  height.series.push_back(Curve("fitted " + std::string(spec.profile), r.achieved, 0, false, r.law));
   deviation.series.push_back(Curve("fitted", r.achieved, 0, true, r.law));
   if (r.compared) {
     height.series.push_back(Curve("compared: " + std::filesystem::path(r.compared_source).filename().string(),

@@ -32,14 +32,8 @@ nlohmann::json CharacteristicsJson(const CharacteristicReport& r) {
 nlohmann::json ParametersJson(const FitDesign& design, double rim_mm) {
   nlohmann::json normalised, mm;
   for (const auto& [name, value] : NormalisedParameters(design)) normalised[name] = value;
-  if (design.family == ProfileFamily::kPolynomial) {
-    for (size_t k = 0; k < design.params.size(); ++k)
-      mm["c" + std::to_string(k + 1) + "_per_mm" + (k == 0 ? std::string() : std::to_string(2 * k + 1))] =
-          design.params[k] / std::pow(rim_mm, 2.0 * k + 1.0);
-  } else {
-    mm["A_mm"] = design.params[0] * rim_mm;
-    if (design.family == ProfileFamily::kHyperboloid) mm["B_mm"] = design.params[1] * rim_mm;
-  }
+  for (size_t k = 0; k < design.params.size(); ++k)
+    mm[design.mm_names[k]] = design.params[k] * std::pow(rim_mm, design.length_powers[k]);
   mm["m_mm"] = design.m * rim_mm;
   mm["rim_radius_mm"] = rim_mm;
   return {{"normalised", normalised}, {"mm", mm}};
@@ -106,7 +100,7 @@ void WriteOdeDesignSensorYaml(const DesignOdeResult& r, const std::string& table
 
 void WriteFitDesignJson(const DesignFitResult& r, const std::string& sensor_file, const std::string& path) {
   nlohmann::json j;
-  j["profile"] = ProfileFamilyName(r.spec.family);
+  j["profile"] = r.spec.profile;
   j["characteristic"] = CharacteristicName(r.spec.characteristic);
   j["targets"] = {{"rim_omega_deg", r.spec.rim_omega_deg}, {"rim_theta_deg", r.spec.rim_theta_deg}};
   j["parameters"] = ParametersJson(r.design, r.rim_radius_mm);

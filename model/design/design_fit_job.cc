@@ -16,21 +16,20 @@ std::string DesignFitOptions::Check() const {
   return {};
 }
 
-ImageCharacteristic DefaultCharacteristic(ProfileFamily family, int polynomial_terms) {
-  if (family == ProfileFamily::kPolynomial && polynomial_terms > 1) return ImageCharacteristic::kEquidistant;
-  if (family == ProfileFamily::kHyperboloid) return ImageCharacteristic::kSingleViewpoint;
-  return ImageCharacteristic::kNone;
+ImageCharacteristic DefaultCharacteristic(const std::string& profile, int terms) {
+  FitDesignSpec spec;
+  spec.profile = profile;
+  spec.terms = terms;
+  spec.characteristic = ImageCharacteristic::kEquidistant;
+  // A hyperboloid is shaped for its single viewpoint; any other family with freedom left
+  // after the rim targets (the spec then checks) for the equidistant law.
+  if (profile == "hyperboloid") return ImageCharacteristic::kSingleViewpoint;
+  return spec.Check().empty() ? ImageCharacteristic::kEquidistant : ImageCharacteristic::kNone;
 }
 
 std::vector<std::pair<std::string, double>> NormalisedParameters(const FitDesign& design) {
   std::vector<std::pair<std::string, double>> parameters;
-  if (design.family == ProfileFamily::kPolynomial) {
-    for (size_t k = 0; k < design.params.size(); ++k)
-      parameters.emplace_back("c" + std::to_string(k + 1), design.params[k]);
-  } else {
-    parameters.emplace_back("A", design.params[0]);
-    if (design.family == ProfileFamily::kHyperboloid) parameters.emplace_back("B", design.params[1]);
-  }
+  for (size_t k = 0; k < design.params.size(); ++k) parameters.emplace_back(design.names[k], design.params[k]);
   parameters.emplace_back("m", design.m);
   return parameters;
 }

@@ -18,7 +18,7 @@
 namespace omnical {
 
 struct DesignFitOptions {
-  // family, polynomial_terms, rim_omega_deg, rim_theta_deg, characteristic (kNone for a
+  // profile, terms, rim_omega_deg, rim_theta_deg, characteristic (kNone for a
   // family with no freedom left; DefaultCharacteristic gives the usual one).
   FitDesignSpec spec;
   double rim_radius_mm = 43.9;  // mirror radius M at the rim: scales the normalised design
@@ -34,9 +34,10 @@ struct DesignFitOptions {
   std::string Check() const;
 };
 
-// The characteristic a family is usually shaped for: equidistant for a polynomial of two or
-// more terms, single viewpoint for a hyperboloid, none for a sphere or a parabola.
-ImageCharacteristic DefaultCharacteristic(ProfileFamily family, int polynomial_terms);
+// The characteristic a family is usually shaped for: single viewpoint for a hyperboloid,
+// equidistant for any other with freedom left after the rim targets (a polynomial of two
+// or more terms, an even asphere), none for a sphere, a paraboloid or one term.
+ImageCharacteristic DefaultCharacteristic(const std::string& profile, int terms);
 
 struct DesignFitResult {
   FitDesignSpec spec;

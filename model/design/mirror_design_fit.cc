@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "model/input_error.h"
+#include "model/model_registry.h"
 #include "model/ray_quantities.h"
 
 namespace omnical {
@@ -23,61 +25,36 @@ struct RimTargets {
         omega_rad(spec.rim_omega_deg * kDegToRad) {}
 };
 
-int FreeParams(const FitDesignSpec& spec) {
-  switch (spec.family) {
-    case ProfileFamily::kSphere: return 0;
-    case ProfileFamily::kHyperboloid: return 1;
-    case ProfileFamily::kPolynomial: return spec.polynomial_terms - 1;
-  }
-  return 0;
+// The profile family as a prototype: its parameter count (the terms) with zero values.
+template <typename Profile>
+Profile Prototype(int terms) {
+  int count = 0;
+  for (const ParameterField& field : Profile::kFields) count += field.is_list() ? terms : 1;
+  const std::vector<double> zeros(std::max(count, 1), 0.0);
+  return Profile::FromParams(zeros.data(), count);
 }
 
 // Sag z and slope dz/dx at radius x (normalised) of the family with these parameters,
 // through the same profile types the sensor model projects with.
-template <typename T>
-void SagAndSlope(ProfileFamily family, const std::vector<T>& params, const T& x, T* z, T* slope) {
-  const T r2 = x * x;
-  SagDerivatives<T> g{T(0.0), T(0.0), T(0.0)};
-  switch (family) {
-    case ProfileFamily::kSphere: g = SphereProfile<T>{params[0]}.template EvaluateSag<T>(r2); break;
-    case ProfileFamily::kHyperboloid: g = HyperboloidProfile<T>{params[0], params[1]}.template EvaluateSag<T>(r2); break;
-    case ProfileFamily::kPolynomial:
-      g = EvenPolynomialProfile<T>::FromParams(params.data(), static_cast<int>(params.size())).template EvaluateSag<T>(r2);
-      break;
-  }
+template <typename Profile, typename T>
+void SagAndSlope(const Profile& family, const std::vector<T>& params, const T& x, T* z, T* slope) {
+  const SagDerivatives<T> g = family.template WithParams<T>(params.data()).template EvaluateSag<T>(x * x);
   T curvature;
   RadialSlopes(g, x, slope, &curvature);
   *z = g.z;
 }
 
-// The family's parameters with the two rim targets solved exactly from the free ones.
-template <typename T>
-std::vector<T> ConstrainedParams(const FitDesignSpec& spec, const RimTargets& rim, const T* free, T* m) {
-  using std::sqrt;
-  std::vector<T> params;
-  switch (spec.family) {
-    case ProfileFamily::kSphere:
-      // f'(1) = 1 / sqrt(A^2 - 1) = tan(beta).
-      params = {T(std::sqrt(1.0 + 1.0 / (rim.tan_beta * rim.tan_beta)))};
-      break;
-    case ProfileFamily::kHyperboloid:
-      // f'(1) = (B / A) / sqrt(A^2 + 1) = tan(beta).
-      params = {free[0], free[0] * sqrt(free[0] * free[0] + T(1.0)) * T(rim.tan_beta)};
-      break;
-    case ProfileFamily::kPolynomial: {
-      // f'(1) = sum 2k c_k = tan(beta), solved for c1.
-      params.assign(spec.polynomial_terms, T(0.0));
-      T rest(0.0);
-      for (int k = 1; k < spec.polynomial_terms; ++k) {
-        params[k] = free[k - 1];
-        rest += T(2.0 * (k + 1)) * params[k];
-      }
-      params[0] = T(0.5) * (T(rim.tan_beta) - rest);
-      break;
-    }
-  }
+// The family's parameters with the two rim targets solved exactly from the free ones
+// (every parameter but kRimSlopeParam, in order).
+template <typename Profile, typename T>
+std::vector<T> ConstrainedParams(const Profile& family, const RimTargets& rim, const T* free, T* m) {
+  const int count = family.NumParams();
+  std::vector<T> params(count, T(0.0));
+  for (int k = 0, next = 0; k < count; ++k)
+    if (k != Profile::kRimSlopeParam) params[k] = free[next++];
+  Profile::SolveRimSlope(params.data(), count, T(rim.tan_beta));
   T z_rim, slope_rim;
-  SagAndSlope(spec.family, params, T(1.0), &z_rim, &slope_rim);
+  SagAndSlope(family, params, T(1.0), &z_rim, &slope_rim);
   *m = T(1.0 / rim.tan_theta) - z_rim;
   return params;
 }
@@ -97,9 +74,11 @@ T LawRatio(ImageCharacteristic characteristic, const T& omega, double rim_omega)
 // One residual per sample x_i = i / samples: the image height's departure from the law
 // (in rim heights), or for a single viewpoint the viewpoint's from the rim ray's (in
 // mirror radii).
+template <typename Profile>
 struct CharacteristicResiduals {
   FitDesignSpec spec;
   RimTargets rim;
+  Profile family;
 
   template <typename T>
   bool operator()(T const* const* free, T* residuals) const {
@@ -108,14 +87,14 @@ struct CharacteristicResiduals {
     using std::cos;
     using std::sin;
     T m;
-    const std::vector<T> params = ConstrainedParams(spec, rim, free[0], &m);
+    const std::vector<T> params = ConstrainedParams(family, rim, free[0], &m);
     T z_rim, slope_rim;
-    SagAndSlope(spec.family, params, T(1.0), &z_rim, &slope_rim);
+    SagAndSlope(family, params, T(1.0), &z_rim, &slope_rim);
     const T viewpoint_rim = z_rim + T(1.0 / std::tan(rim.omega_rad));
     for (int i = 1; i <= spec.samples; ++i) {
       const T x(static_cast<double>(i) / spec.samples);
       T z, slope;
-      SagAndSlope(spec.family, params, x, &z, &slope);
+      SagAndSlope(family, params, x, &z, &slope);
       const T omega = T(2.0) * atan(slope) + atan2(x, m + z);
       if (spec.characteristic == ImageCharacteristic::kSingleViewpoint) {
         residuals[i - 1] = z + x * cos(omega) / sin(omega) - viewpoint_rim;
@@ -127,26 +106,26 @@ struct CharacteristicResiduals {
   }
 };
 
-
 // The image must be one-to-one: Omega and the image height grow with x, the lens below
 // the mirror.
-void CheckPhysical(const FitDesignSpec& spec, const FitDesign& design) {
-  const char* family = ProfileFamilyName(spec.family);
+template <typename Profile>
+void CheckPhysical(const Profile& family, const FitDesign& design) {
+  const char* name = Profile::kName;
   if (!(design.m > 0.0))
-    throw InputError(std::string("design fit: the fitted ") + family + " puts the lens at m = " + std::to_string(design.m) +
+    throw InputError(std::string("design fit: the fitted ") + name + " puts the lens at m = " + std::to_string(design.m) +
                      " (must be > 0: the rim targets ask for a lens inside the mirror)");
   constexpr int kChecks = 4000;
   double previous_omega = 0.0, previous_h = 0.0;
   for (int i = 1; i <= kChecks; ++i) {
     const double x = static_cast<double>(i) / kChecks;
     double z, slope;
-    SagAndSlope(spec.family, design.params, x, &z, &slope);
+    SagAndSlope(family, design.params, x, &z, &slope);
     const double h = x / (design.m + z);
     const double omega = 2.0 * std::atan(slope) + std::atan2(x, design.m + z);
-    if (!(design.m + z > 0.0) || !(h > previous_h) || !(omega > previous_omega)) {
+    if (!(design.m + z > 0.0) || !(h > previous_h) || !(omega > previous_omega) || !std::isfinite(omega)) {
       char why[200];
       std::snprintf(why, sizeof why, "design fit: the fitted %s folds the image: %s stops increasing at x = %.4f (mirror radii)",
-                    family, !(omega > previous_omega) ? "Omega" : "the image height", x);
+                    name, !(omega > previous_omega) ? "Omega" : "the image height", x);
       throw InputError(why);
     }
     previous_omega = omega;
@@ -154,16 +133,94 @@ void CheckPhysical(const FitDesignSpec& spec, const FitDesign& design) {
   }
 }
 
-}  // namespace
-
-const char* ProfileFamilyName(ProfileFamily family) {
-  switch (family) {
-    case ProfileFamily::kSphere: return "sphere";
-    case ProfileFamily::kPolynomial: return "polynomial";
-    case ProfileFamily::kHyperboloid: return "hyperboloid";
+template <typename Profile>
+FitDesign FitFamily(const FitDesignSpec& spec, const ProgressCallback& progress) {
+  const RimTargets rim(spec);
+  const Profile family = Prototype<Profile>(spec.terms);
+  FitDesign design;
+  design.profile = Profile::kName;
+  design.free_params = family.NumParams() - 1;
+  // Starting points: the free parameters at 0 but those that must be positive at 1 (one
+  // mirror radius): the polynomial starts from the parabola through the rim slope, the
+  // hyperboloid from A = 1.
+  std::vector<double> free;
+  std::vector<bool> positive;
+  ForEachProfileParameter<Profile>(family.NumParams(), [&](const ParameterField& field, int, int index) {
+    if (index == Profile::kRimSlopeParam) return;
+    positive.push_back(field.domain == FieldDomain::kPositive);
+    free.push_back(positive.back() ? 1.0 : 0.0);
+  });
+  if (design.free_params > 0) {
+    auto* cost = new ceres::DynamicAutoDiffCostFunction<CharacteristicResiduals<Profile>, 4>(
+        new CharacteristicResiduals<Profile>{spec, rim, family});
+    cost->AddParameterBlock(design.free_params);
+    cost->SetNumResiduals(spec.samples);
+    ceres::Problem problem;
+    problem.AddResidualBlock(cost, nullptr, free.data());
+    for (int k = 0; k < design.free_params; ++k)
+      if (positive[k]) problem.SetParameterLowerBound(free.data(), k, 1e-6);
+    ceres::Solver::Options options;
+    options.linear_solver_type = ceres::DENSE_QR;
+    options.max_num_iterations = 500;
+    options.function_tolerance = 1e-16;
+    options.gradient_tolerance = 1e-16;
+    options.parameter_tolerance = 1e-14;
+    options.logging_type = ceres::SILENT;  // a library never prints (a step off the domain is routine)
+    ProgressReporter reporter(progress, "fit", options.max_num_iterations);
+    reporter.ThrowIfCancelled();
+    IterationProgress iteration_progress(&reporter);
+    options.callbacks.push_back(&iteration_progress);
+    ceres::Solver::Summary summary;
+    ceres::Solve(options, &problem, &summary);
+    reporter.ThrowIfCancelled();
+    design.iterations = static_cast<int>(summary.iterations.size()) - 1;
+    design.final_cost = summary.final_cost;
+    design.solver_report = summary.BriefReport();
+    if (summary.termination_type != ceres::CONVERGENCE)
+      throw InputError("design fit: Ceres did not converge for the " + design.profile + " (" + summary.message + ")");
+  } else {
+    design.solver_report = "closed form (no free parameter after the rim targets)";
   }
-  return "?";
+  design.params = ConstrainedParams(family, rim, free.data(), &design.m);
+  ForEachProfileParameter<Profile>(family.NumParams(), [&](const ParameterField& field, int k, int) {
+    const int power = field.TermLengthPower(k);
+    design.names.push_back(field.is_list() ? field.TermName(k) : field.key);
+    design.mm_names.push_back(field.is_list() ? field.TermName(k) + "_per_mm" + (power == -1 ? "" : std::to_string(-power))
+                                              : field.name);
+    design.length_powers.push_back(power);
+  });
+  CheckPhysical(family, design);
+  return design;
 }
+
+// Calls f(TypeTag<Catadioptric<double, Profile, PinholeLens>>) for the design profile of
+// that name; false if there is none.
+template <typename F>
+bool WithDesignProfile(const std::string& name, const F& f) {
+  bool found = false;
+  ForEachModelType([&](auto tag) {
+    using Model = typename decltype(tag)::type;
+    using Profile = typename Model::ProfileType;
+    if constexpr (Profile::kRimSlopeParam >= 0 && !Model::kOrthographic) {
+      if (found || name != Profile::kName) return;
+      found = true;
+      f(tag);
+    }
+  });
+  return found;
+}
+
+// The number of free parameters after the rim targets, -1 for an unknown profile.
+int FreeParams(const FitDesignSpec& spec) {
+  int free = -1;
+  WithDesignProfile(spec.profile, [&](auto tag) {
+    using Profile = typename decltype(tag)::type::ProfileType;
+    free = Prototype<Profile>(spec.terms).NumParams() - 1;
+  });
+  return free;
+}
+
+}  // namespace
 
 const char* CharacteristicName(ImageCharacteristic characteristic) {
   switch (characteristic) {
@@ -181,62 +238,34 @@ std::string FitDesignSpec::Check() const {
     return "rim_theta_deg: must be in (0, 90) deg (the lens's half field at the rim)";
   if (!std::isfinite(rim_omega_deg) || !(rim_omega_deg > rim_theta_deg && rim_omega_deg < 180.0))
     return "rim_omega_deg: must lie between rim_theta_deg and 180 deg (Omega = 2 beta + Theta with a slope 0 < beta < 90 deg)";
-  if (family == ProfileFamily::kPolynomial && (polynomial_terms < 1 || polynomial_terms > 8))
-    return "polynomial_terms: a polynomial has 1 to 8 even terms";
+  std::string terms_problem;
+  const bool known = WithDesignProfile(profile, [&](auto tag) {
+    using Profile = typename decltype(tag)::type::ProfileType;
+    const ParameterField& last = Profile::kFields.back();
+    if (last.is_list() && (terms < last.min_count || terms > last.max_count))
+      terms_problem = "terms: a " + profile + " has " + std::to_string(last.min_count) + " to " +
+                      std::to_string(last.max_count) + " terms";
+  });
+  if (!known) return "profile: must be " + JoinChoices(DesignProfileNames()) + ", not '" + profile + "'";
+  if (!terms_problem.empty()) return terms_problem;
   if (samples < 10 || samples > 100000) return "samples: must be in [10, 100000]";
   const int free = FreeParams(*this);
   if (free == 0 && characteristic != ImageCharacteristic::kNone)
-    return std::string("characteristic: a ") + ProfileFamilyName(family) +
-           (family == ProfileFamily::kPolynomial ? " of one term" : "") +
+    return "characteristic: a " + profile + (profile == "polynomial" ? " of one term" : "") +
            " is fixed by the two rim targets; nothing is left to shape for a characteristic (its laws are reported in "
            "design.json anyway)";
   if (free > 0 && characteristic == ImageCharacteristic::kNone)
-    return std::string("characteristic: a ") + ProfileFamilyName(family) + " keeps " + std::to_string(free) +
+    return "characteristic: a " + profile + " keeps " + std::to_string(free) +
            " free parameter(s) after the rim targets; name the characteristic that fixes them";
   return {};
 }
 
 FitDesign FitMirrorDesign(const FitDesignSpec& spec, const ProgressCallback& progress) {
   if (const std::string why = spec.Check(); !why.empty()) throw InputError("design fit: " + why);
-  const RimTargets rim(spec);
   FitDesign design;
-  design.family = spec.family;
-  design.free_params = FreeParams(spec);
-  std::vector<double> free(design.free_params, 0.0);
-  // Starting points: the polynomial from the parabola through the rim slope (c2.. = 0),
-  // the hyperboloid from A = 1 (one mirror radius).
-  if (spec.family == ProfileFamily::kHyperboloid) free[0] = 1.0;
-  if (design.free_params > 0) {
-    auto* cost = new ceres::DynamicAutoDiffCostFunction<CharacteristicResiduals, 4>(new CharacteristicResiduals{spec, rim});
-    cost->AddParameterBlock(design.free_params);
-    cost->SetNumResiduals(spec.samples);
-    ceres::Problem problem;
-    problem.AddResidualBlock(cost, nullptr, free.data());
-    if (spec.family == ProfileFamily::kHyperboloid) problem.SetParameterLowerBound(free.data(), 0, 1e-6);
-    ceres::Solver::Options options;
-    options.linear_solver_type = ceres::DENSE_QR;
-    options.max_num_iterations = 500;
-    options.function_tolerance = 1e-16;
-    options.gradient_tolerance = 1e-16;
-    options.parameter_tolerance = 1e-14;
-    ProgressReporter reporter(progress, "fit", options.max_num_iterations);
-    reporter.ThrowIfCancelled();
-    IterationProgress iteration_progress(&reporter);
-    options.callbacks.push_back(&iteration_progress);
-    ceres::Solver::Summary summary;
-    ceres::Solve(options, &problem, &summary);
-    reporter.ThrowIfCancelled();
-    design.iterations = static_cast<int>(summary.iterations.size()) - 1;
-    design.final_cost = summary.final_cost;
-    design.solver_report = summary.BriefReport();
-    if (summary.termination_type != ceres::CONVERGENCE)
-      throw InputError("design fit: Ceres did not converge for the " + std::string(ProfileFamilyName(spec.family)) + " (" +
-                       summary.message + ")");
-  } else {
-    design.solver_report = "closed form (no free parameter after the rim targets)";
-  }
-  design.params = ConstrainedParams(spec, rim, free.data(), &design.m);
-  CheckPhysical(spec, design);
+  WithDesignProfile(spec.profile, [&](auto tag) {
+    design = FitFamily<typename decltype(tag)::type::ProfileType>(spec, progress);
+  });
   return design;
 }
 
@@ -244,36 +273,21 @@ Sensor SensorFromFitDesign(const FitDesign& design, const FitDesignSpec& spec, d
   const double scale = rim_radius_mm;
   const double focal_px = 0.5 * image_size_px / std::tan(spec.rim_theta_deg * kDegToRad);
   const double centre_px = 0.5 * (image_size_px - 1);
-  const PinholeLens<double> lens{focal_px, focal_px, centre_px, centre_px, 0.0, 0.0};
-  const MirrorPose<double> pose{design.m * scale, 0.0, 0.0, 0.0, 0.0};
-  auto finish = [&](auto model) {
-    model.lens = lens;
-    model.pose = pose;
+  std::optional<Sensor> sensor;
+  WithDesignProfile(design.profile, [&](auto tag) {
+    typename decltype(tag)::type model;
+    model.lens = PinholeLens<double>{focal_px, focal_px, centre_px, centre_px, 0.0, 0.0};
+    model.pose = MirrorPose<double>{design.m * scale, 0.0, 0.0, 0.0, 0.0};
+    // A parameter of length power p (z = sum c_k x^2k: c_k in mm^(1-2k)) scales by M^p.
+    std::vector<double> mm(design.params.size());
+    for (size_t k = 0; k < mm.size(); ++k) mm[k] = design.params[k] * std::pow(scale, design.length_powers[k]);
+    model.mirror = Prototype<typename decltype(tag)::type::ProfileType>(spec.terms).WithParams(mm.data());
     model.rim_radius_mm = rim_radius_mm;
     model.image_width_px = model.image_height_px = image_size_px;
-    return Sensor(model);
-  };
-  switch (design.family) {
-    case ProfileFamily::kSphere: {
-      Catadioptric<double, SphereProfile, PinholeLens> model;
-      model.mirror = {design.params[0] * scale};
-      return finish(model);
-    }
-    case ProfileFamily::kHyperboloid: {
-      Catadioptric<double, HyperboloidProfile, PinholeLens> model;
-      model.mirror = {design.params[0] * scale, design.params[1] * scale};
-      return finish(model);
-    }
-    case ProfileFamily::kPolynomial: {
-      // z = sum c_k x^2k with x in mirror radii: c_k (mm^(1-2k)) = c_k / M^(2k-1).
-      Catadioptric<double, EvenPolynomialProfile, PinholeLens> model;
-      model.mirror.num_coefficients = static_cast<int>(design.params.size());
-      for (size_t k = 0; k < design.params.size(); ++k)
-        model.mirror.coefficients[k] = design.params[k] / std::pow(scale, 2.0 * (k + 1) - 1.0);
-      return finish(model);
-    }
-  }
-  throw InputError("design fit: unknown profile family");
+    sensor = Sensor(model);
+  });
+  if (!sensor) throw InputError("design fit: unknown profile family '" + design.profile + "'");
+  return *sensor;
 }
 
 double LawHeightRatio(ImageCharacteristic characteristic, double omega_rad, double rim_omega_rad) {

@@ -1,8 +1,9 @@
 // Mirror design by parameters (Ohte & Tsuzuki 2012, Sec. 3.1 and Table 1), solved with
-// Ceres instead of the paper's trial and error: a profile family (sphere, even polynomial,
-// hyperboloid) whose rim ray has exactly the target Omega and Theta, and whose image
-// follows a characteristic (equidistant, single viewpoint, constant aspect ratio, equal
-// area) as closely as the family allows.
+// Ceres instead of the paper's trial and error: a profile family of the registry (every
+// profile with a kRimSlopeParam: sphere, even polynomial, hyperboloid, paraboloid, even
+// asphere; model/model_registry.h) whose rim ray has exactly the target Omega and Theta,
+// and whose image follows a characteristic (equidistant, single viewpoint, constant aspect
+// ratio, equal area) as closely as the family allows.
 //
 // Units are the paper's normalised ones (mirror radius M = 1 at the rim, lens principal
 // point at (0, -m), SEED-NOTES "Conventions"); SensorFromFitDesign scales to mm. The two
@@ -10,8 +11,9 @@
 // Ceres only moves the family's remaining freedom:
 //   tan(beta_rim) = f'(1) with beta_rim = (Omega_rim - Theta_rim) / 2   (Eq. 4)
 //   m = 1 / tan(Theta_rim) - f(1)                                          (Eq. 5)
-// A sphere has no freedom left (A and m follow in closed form), a hyperboloid one (A), an
-// n-term polynomial n - 1 (c2..cn).
+// A sphere or paraboloid has no freedom left (A and m follow in closed form), a
+// hyperboloid one (A), an n-term polynomial n - 1 (c2..cn), an even asphere with n terms
+// n + 1 (k, a4, ...): each profile's SolveRimSlope sets the one parameter the slope fixes.
 #pragma once
 
 #include <string>
@@ -22,7 +24,6 @@
 
 namespace omnical {
 
-enum class ProfileFamily { kSphere, kPolynomial, kHyperboloid };
 // The image law each characteristic asks for, with h the image radius and h_rim the rim's:
 //   equidistant      h / h_rim = Omega / Omega_rim            (Sec. 3.5)
 //   constant aspect  h / h_rim = tan(Omega/2) / tan(Omega_rim/2)  (Eq. 12 equal to 1)
@@ -30,12 +31,13 @@ enum class ProfileFamily { kSphere, kPolynomial, kHyperboloid };
 //   single viewpoint z_v = z + x / tan(Omega) the same for every ray (Eq. 6)
 enum class ImageCharacteristic { kNone, kEquidistant, kSingleViewpoint, kConstantAspect, kEqualArea };
 
-const char* ProfileFamilyName(ProfileFamily family);
 const char* CharacteristicName(ImageCharacteristic characteristic);
 
 struct FitDesignSpec {
-  ProfileFamily family = ProfileFamily::kPolynomial;
-  int polynomial_terms = 3;  // c1 x^2 + ... + cn x^2n (Table 1's E-DI: 3)
+  std::string profile = "polynomial";  // one of DesignProfileNames() (model/model_registry.h)
+  // The profile's list of terms (polynomial: c1 x^2 + ... + cn x^2n, Table 1's E-DI: 3;
+  // even asphere: a4 x^4 ...); ignored by a profile without one.
+  int terms = 3;
   double rim_omega_deg = 135.0;
   double rim_theta_deg = 12.0;
   ImageCharacteristic characteristic = ImageCharacteristic::kNone;
@@ -45,10 +47,13 @@ struct FitDesignSpec {
 };
 
 struct FitDesign {
-  ProfileFamily family = ProfileFamily::kSphere;
+  std::string profile;
   // Normalised parameters as Table 1 prints them: sphere {A}; hyperboloid {A, B};
-  // polynomial {c1, ..., cn} (the table's A, B, C for n = 3).
+  // polynomial {c1, ..., cn} (the table's A, B, C for n = 3); even asphere {R, k, a4, ..}.
   std::vector<double> params;
+  std::vector<std::string> names;     // sensor-file keys (A, B, R, k) or terms (c1, a4)
+  std::vector<std::string> mm_names;  // the same in mm: A_mm, c2_per_mm3, k, a4_per_mm3
+  std::vector<int> length_powers;     // a parameter in mm is the normalised one x rim^p
   double m = 0.0;
   int free_params = 0;
   int iterations = 0;

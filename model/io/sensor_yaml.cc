@@ -1,10 +1,12 @@
 // Sensor file reader and writer (yaml-cpp). Every field is checked; an unknown field is
 // an error too, because a misspelt optional key would otherwise be silently ignored.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -21,48 +23,71 @@ constexpr double kDegToRad = M_PI / 180.0;
 
 using FieldReader = YamlFieldReader;
 
-struct LensChoice {
-  PinholeLens<double> pinhole{};
-  OrthographicLens<double> orthographic{};
-  bool is_orthographic = false;
+// A lens or profile's fields read into its flat parameter array (model/parameter_field.h).
+std::vector<double> ReadFields(const FieldReader& reader, const YAML::Node& section, const std::string& where,
+                               const ParameterField* fields, size_t num_fields) {
+  std::vector<double> params;
+  for (size_t f = 0; f < num_fields; ++f) {
+    const ParameterField& field = fields[f];
+    const std::string name = where + "." + field.key;
+    const YAML::Node node = section[field.key];
+    if (field.is_list()) {
+      if (!node) {
+        if (field.min_count > 0) reader.Fail(name, "missing");
+        continue;
+      }
+      for (double value : reader.Numbers(node, name, field.min_count, field.max_count)) {
+        if (!(std::abs(value) <= field.bound)) reader.Fail(name, "magnitudes must be <= " + FieldReader::Format(field.bound));
+        params.push_back(value);
+      }
+    } else if (!node && field.optional) {
+      params.push_back(0.0);
+    } else if (field.domain == FieldDomain::kPositive) {
+      params.push_back(reader.Positive(node, name, field.bound));
+    } else {
+      params.push_back(reader.Bounded(node, name, field.bound));
+    }
+  }
+  return params;
+}
+
+// A domain problem "key: reason" of a section's field is reported at that field.
+[[noreturn]] void FailDomain(const FieldReader& reader, const std::string& where, const std::string& why) {
+  const size_t colon = why.find(": ");
+  if (colon != std::string::npos && why.find(' ') == colon + 1) reader.Fail(where + "." + why.substr(0, colon), why.substr(colon + 2));
+  reader.Fail(where, why);
+}
+
+template <typename Fields>
+std::set<std::string> Keys(const Fields& fields, std::set<std::string> keys) {
+  for (const ParameterField& field : fields) keys.insert(field.key);
+  return keys;
+}
+
+struct SectionsRead {
+  std::string lens, profile;
   int width = 0, height = 0;
-  double body_radius_mm = 0.0;
+  double body_radius_mm = 0.0, rim_mm = 0.0;
 };
 
-LensChoice ReadCamera(const FieldReader& reader, const YAML::Node& root) {
+SectionsRead ReadCommon(const FieldReader& reader, const YAML::Node& root) {
+  SectionsRead read;
   const YAML::Node camera = reader.Section(root, "camera");
-  LensChoice lens;
-  const std::string model = reader.Text(camera["model"], "camera.model");
+  read.lens = reader.Text(camera["model"], "camera.model");
   const YAML::Node size = camera["image_size"];
   if (!size) reader.Fail("camera.image_size", "missing");
   const std::vector<double> wh = reader.Numbers(size, "camera.image_size", 2, 2);
   for (int k = 0; k < 2; ++k)
     if (!(wh[k] >= 1.0 && wh[k] <= 1e6 && wh[k] == std::floor(wh[k])))
       reader.Fail("camera.image_size", "must be two positive whole numbers [width, height]");
-  lens.width = static_cast<int>(wh[0]);
-  lens.height = static_cast<int>(wh[1]);
-  lens.body_radius_mm = camera["body_radius_mm"] ? reader.Bounded(camera["body_radius_mm"], "camera.body_radius_mm", 1e5) : 0.0;
-  if (lens.body_radius_mm < 0.0) reader.Fail("camera.body_radius_mm", "must be >= 0");
-  if (model == "pinhole") {
-    reader.RejectUnknown(camera, "camera", {"model", "image_size", "fx", "fy", "cx", "cy", "k1", "k2", "body_radius_mm"});
-    PinholeLens<double>& p = lens.pinhole;
-    p.fx_px = reader.Positive(camera["fx"], "camera.fx", 1e8);
-    p.fy_px = reader.Positive(camera["fy"], "camera.fy", 1e8);
-    if (p.fx_px < 1e-3 || p.fy_px < 1e-3) reader.Fail("camera.fx", "focal lengths below 1e-3 px are not a camera");
-    p.cx_px = reader.Bounded(camera["cx"], "camera.cx", 1e7);
-    p.cy_px = reader.Bounded(camera["cy"], "camera.cy", 1e7);
-    p.k1 = camera["k1"] ? reader.Bounded(camera["k1"], "camera.k1", 1e6) : 0.0;
-    p.k2 = camera["k2"] ? reader.Bounded(camera["k2"], "camera.k2", 1e6) : 0.0;
-  } else if (model == "orthographic") {
-    reader.RejectUnknown(camera, "camera", {"model", "image_size", "scale_px_per_mm", "cx", "cy", "body_radius_mm"});
-    lens.is_orthographic = true;
-    lens.orthographic.scale_px_per_mm = reader.Positive(camera["scale_px_per_mm"], "camera.scale_px_per_mm", 1e6);
-    lens.orthographic.cx_px = reader.Bounded(camera["cx"], "camera.cx", 1e7);
-    lens.orthographic.cy_px = reader.Bounded(camera["cy"], "camera.cy", 1e7);
-  } else {
-    reader.Fail("camera.model", "unknown lens model '" + model + "' (expected pinhole or orthographic)");
-  }
-  return lens;
+  read.width = static_cast<int>(wh[0]);
+  read.height = static_cast<int>(wh[1]);
+  read.body_radius_mm = camera["body_radius_mm"] ? reader.Bounded(camera["body_radius_mm"], "camera.body_radius_mm", 1e5) : 0.0;
+  if (read.body_radius_mm < 0.0) reader.Fail("camera.body_radius_mm", "must be >= 0");
+  const std::vector<std::string> lenses = LensNames();
+  if (std::find(lenses.begin(), lenses.end(), read.lens) == lenses.end())
+    reader.Fail("camera.model", "unknown lens model '" + read.lens + "' (expected " + JoinChoices(lenses) + ")");
+  return read;
 }
 
 MirrorPose<double> ReadPose(const FieldReader& reader, const YAML::Node& root) {
@@ -87,70 +112,68 @@ MirrorPose<double> ReadPose(const FieldReader& reader, const YAML::Node& root) {
   return out;
 }
 
-template <template <typename> class Profile>
-SensorModel Assemble(const Profile<double>& profile, const LensChoice& lens, const MirrorPose<double>& pose,
-                     double rim_mm) {
-  auto fill = [&](auto model) -> SensorModel {
-    model.mirror = profile;
-    model.pose = pose;
-    model.rim_radius_mm = rim_mm;
-    model.image_width_px = lens.width;
-    model.image_height_px = lens.height;
-    model.camera_body_radius_mm = lens.body_radius_mm;
-    return model;
-  };
-  if (lens.is_orthographic) {
-    Catadioptric<double, Profile, OrthographicLens> model;
-    model.lens = lens.orthographic;
-    return fill(model);
-  }
-  Catadioptric<double, Profile, PinholeLens> model;
-  model.lens = lens.pinhole;
-  return fill(model);
-}
-
-SensorModel ReadMirror(const FieldReader& reader, const YAML::Node& root, const LensChoice& lens,
-                       const MirrorPose<double>& pose) {
+// The registered model of the file's lens and profile, every field read through the
+// registry's descriptions (a tabulated profile reads its table).
+SensorModel ReadModel(const FieldReader& reader, const YAML::Node& root) {
+  const SectionsRead read = ReadCommon(reader, root);
+  const YAML::Node camera = root["camera"];
   const YAML::Node mirror = reader.Section(root, "mirror");
   const std::string profile = reader.Text(mirror["profile"], "mirror.profile");
-  const double rim = reader.Positive(mirror["rim_radius"], "mirror.rim_radius", 1e5);
-  if (rim < 1e-3) reader.Fail("mirror.rim_radius", "must be >= 1e-3 mm");
-  if (profile == "sphere") {
-    reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "A"});
-    return Assemble(SphereProfile<double>{reader.Positive(mirror["A"], "mirror.A", 1e7)}, lens, pose, rim);
-  }
-  if (profile == "polynomial") {
-    reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "coefficients"});
-    if (!mirror["coefficients"]) reader.Fail("mirror.coefficients", "missing");
-    const std::vector<double> c = reader.Numbers(mirror["coefficients"], "mirror.coefficients", 1,
-                                                 EvenPolynomialProfile<double>::kMaxCoefficients);
-    return Assemble(EvenPolynomialProfile<double>::FromParams(c.data(), static_cast<int>(c.size())), lens, pose, rim);
-  }
-  if (profile == "hyperboloid") {
-    reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "A", "B"});
-    return Assemble(HyperboloidProfile<double>{reader.Positive(mirror["A"], "mirror.A", 1e7),
-                                               reader.Positive(mirror["B"], "mirror.B", 1e7)},
-                    lens, pose, rim);
-  }
-  if (profile == "paraboloid") {
-    reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "A"});
-    return Assemble(ParaboloidProfile<double>{reader.Positive(mirror["A"], "mirror.A", 1e7)}, lens, pose, rim);
-  }
-  if (profile == "tabulated") {
-    reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "table"});
-    std::filesystem::path table = reader.Text(mirror["table"], "mirror.table");
-    if (table.is_relative()) table = std::filesystem::path(reader.path()).parent_path() / table;
-    TabulatedProfile<double> tabulated;
-    tabulated.source = std::filesystem::weakly_canonical(table).string();
-    try {
-      tabulated.spline = LoadProfileTable(table.string());
-    } catch (const InputError& error) {
-      reader.Fail("mirror.table", std::string("cannot read the profile table: ") + error.what());
+  const std::vector<std::string> profiles = ProfileNames();
+  if (std::find(profiles.begin(), profiles.end(), profile) == profiles.end())
+    reader.Fail("mirror.profile", "unknown profile '" + profile + "' (expected " + JoinChoices(profiles) + ")");
+  std::optional<SensorModel> model;
+  ForEachModelType([&](auto tag) {
+    using Model = typename decltype(tag)::type;
+    using Lens = typename Model::LensType;
+    using Profile = typename Model::ProfileType;
+    if (model || read.lens != Lens::kName || profile != Profile::kName) return;
+    reader.RejectUnknown(camera, "camera", Keys(Lens::kFields, {"model", "image_size", "body_radius_mm"}));
+    Model m;
+    const std::vector<double> lens = ReadFields(reader, camera, "camera", Lens::kFields.data(), Lens::kFields.size());
+    m.lens = Lens::FromParams(lens.data());
+    if (const std::string why = m.lens.CheckDomain(); !why.empty()) FailDomain(reader, "camera", why);
+    m.pose = ReadPose(reader, root);
+    m.rim_radius_mm = reader.Positive(mirror["rim_radius"], "mirror.rim_radius", 1e5);
+    if (m.rim_radius_mm < 1e-3) reader.Fail("mirror.rim_radius", "must be >= 1e-3 mm");
+    if constexpr (kFittedProfile<Profile>) {
+      reader.RejectUnknown(mirror, "mirror", Keys(Profile::kFields, {"profile", "rim_radius"}));
+      const std::vector<double> shape = ReadFields(reader, mirror, "mirror", Profile::kFields.data(), Profile::kFields.size());
+      m.mirror = Profile::FromParams(shape.data(), static_cast<int>(shape.size()));
+    } else {
+      reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "table"});
+      std::filesystem::path table = reader.Text(mirror["table"], "mirror.table");
+      if (table.is_relative()) table = std::filesystem::path(reader.path()).parent_path() / table;
+      m.mirror.source = std::filesystem::weakly_canonical(table).string();
+      try {
+        m.mirror.spline = LoadProfileTable(table.string());
+      } catch (const InputError& error) {
+        reader.Fail("mirror.table", std::string("cannot read the profile table: ") + error.what());
+      }
     }
-    return Assemble(tabulated, lens, pose, rim);
+    m.image_width_px = read.width;
+    m.image_height_px = read.height;
+    m.camera_body_radius_mm = read.body_radius_mm;
+    model = m;
+  });
+  return *model;
+}
+
+// A lens or profile's fields written from its flat parameter array: a scalar as its key,
+// a list as a flow sequence.
+void WriteFields(YAML::Emitter& out, const ParameterField* fields, size_t num_fields, const std::vector<int>& counts,
+                 const double* params) {
+  int index = 0;
+  for (size_t f = 0; f < num_fields; ++f) {
+    if (!fields[f].is_list()) {
+      out << YAML::Key << fields[f].key << YAML::Value << params[index++];
+      continue;
+    }
+    if (counts[f] == 0) continue;
+    out << YAML::Key << fields[f].key << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (int k = 0; k < counts[f]; ++k) out << params[index++];
+    out << YAML::EndSeq;
   }
-  reader.Fail("mirror.profile", "unknown profile '" + profile +
-                                    "' (expected sphere, polynomial, hyperboloid, paraboloid or tabulated)");
 }
 
 }  // namespace
@@ -164,9 +187,7 @@ Sensor SensorFromRoot(const YAML::Node& root, const FieldReader& reader) {
   try {
     // tolerances: the design tolerances of a guess, read by calib (design_tolerances.h).
     reader.RejectUnknown(root, "", {"camera", "mirror", "pose", "tolerances"});
-    const LensChoice lens = ReadCamera(reader, root);
-    const MirrorPose<double> pose = ReadPose(reader, root);
-    SensorModel model = ReadMirror(reader, root, lens, pose);
+    SensorModel model = ReadModel(reader, root);
     if (std::string why = ValidateSensorModel(model); !why.empty()) throw InputError(path + ": " + why);
     return Sensor(std::move(model));
   } catch (const YAML::Exception& error) {
@@ -203,33 +224,23 @@ std::string SensorYamlText(const Sensor& sensor) {
         out << YAML::Key << "model" << YAML::Value << Model::LensType::kName;
         out << YAML::Key << "image_size" << YAML::Value << YAML::Flow << YAML::BeginSeq << m.image_width_px
             << m.image_height_px << YAML::EndSeq;
-        if constexpr (Model::kOrthographic) {
-          out << YAML::Key << "scale_px_per_mm" << YAML::Value << m.lens.scale_px_per_mm;
-        } else {
-          out << YAML::Key << "fx" << YAML::Value << m.lens.fx_px << YAML::Key << "fy" << YAML::Value << m.lens.fy_px;
-        }
-        out << YAML::Key << "cx" << YAML::Value << m.lens.cx_px << YAML::Key << "cy" << YAML::Value << m.lens.cy_px;
-        if constexpr (!Model::kOrthographic) {
-          out << YAML::Key << "k1" << YAML::Value << m.lens.k1 << YAML::Key << "k2" << YAML::Value << m.lens.k2;
-        }
+        using Lens = typename Model::LensType;
+        using Profile = typename Model::ProfileType;
+        double lens[Lens::kNumParams];
+        m.lens.ToParams(lens);
+        WriteFields(out, Lens::kFields.data(), Lens::kFields.size(), std::vector<int>(Lens::kNumParams, 1), lens);
         if (m.camera_body_radius_mm > 0.0)
           out << YAML::Key << "body_radius_mm" << YAML::Value << m.camera_body_radius_mm;
         out << YAML::EndMap;
 
         out << YAML::Key << "mirror" << YAML::Value << YAML::Flow << YAML::BeginMap;
-        out << YAML::Key << "profile" << YAML::Value << Model::ProfileType::kName;
+        out << YAML::Key << "profile" << YAML::Value << Profile::kName;
         out << YAML::Key << "rim_radius" << YAML::Value << m.rim_radius_mm;
-        using Profile = typename Model::ProfileType;
-        if constexpr (std::is_same_v<Profile, SphereProfile<double>>) {
-          out << YAML::Key << "A" << YAML::Value << m.mirror.radius_of_curvature_mm;
-        } else if constexpr (std::is_same_v<Profile, EvenPolynomialProfile<double>>) {
-          out << YAML::Key << "coefficients" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-          for (int k = 0; k < m.mirror.num_coefficients; ++k) out << m.mirror.coefficients[k];
-          out << YAML::EndSeq;
-        } else if constexpr (std::is_same_v<Profile, HyperboloidProfile<double>>) {
-          out << YAML::Key << "A" << YAML::Value << m.mirror.a_mm << YAML::Key << "B" << YAML::Value << m.mirror.b_mm;
-        } else if constexpr (std::is_same_v<Profile, ParaboloidProfile<double>>) {
-          out << YAML::Key << "A" << YAML::Value << m.mirror.focal_distance_mm;
+        if constexpr (kFittedProfile<Profile>) {
+          std::vector<double> shape(m.mirror.NumParams());
+          m.mirror.ToParams(shape.data());
+          WriteFields(out, Profile::kFields.data(), Profile::kFields.size(), FieldCounts<Profile>(m.mirror.NumParams()),
+                      shape.data());
         } else {
           out << YAML::Key << "table" << YAML::Value << m.mirror.source;
         }

@@ -232,7 +232,7 @@ def test_design_fit_bad_input(data, tmp_path, cli):
     assert "tilted or decentred" in str(error.value)
     assert str(error.value) == cli_error(cli("design", "fit", "--profile", "polynomial", "--compare", tilted,
                                              "--out", bad))
-    with pytest.raises(omnical.InputError, match="^profile: must be sphere, polynomial or hyperboloid, not 'cone'$"):
+    with pytest.raises(omnical.InputError, match="^profile: must be sphere, polynomial, hyperboloid, paraboloid or even_asphere, not 'cone'$"):
         omnical.design_fit(profile="cone")
     with pytest.raises(omnical.InputError, match="^characteristic: must be none, equidistant, svp, aspect or area"):
         omnical.design_fit(profile="polynomial", characteristic="linear")

@@ -226,3 +226,28 @@ def test_status_enum_matches_the_files_names():
         "no_solution", "invalid_input"]
     assert omnical.ProjectionStatus.INVALID_INPUT == 7 and omnical.status_name(2) == "behind_mirror"
     assert issubclass(omnical.InputError, ValueError)
+
+
+def test_the_registrys_choices_and_the_even_asphere_of_a_catalogue(data):
+    """The profile list comes from the model registry; the even asphere with the
+    hyperboloid's conic constant is the shipped SVP sensor (to 1e-9 px, the C++ test's bound)."""
+    assert omnical.PROFILES == ["sphere", "polynomial", "hyperboloid", "paraboloid", "tabulated", "even_asphere"]
+    assert omnical.LENSES == ["pinhole", "orthographic"]
+    assert "tabulated" not in omnical.DESIGN_PROFILES and "even_asphere" in omnical.DESIGN_PROFILES
+    svp = omnical.Sensor.load(data / "sensors" / "ohte-svp.yaml")
+    parameters = svp.parameters
+    a, b = parameters["mirror"]["A"], parameters["mirror"]["B"]
+    parameters["mirror"] = {"profile": "even_asphere", "rim_radius": parameters["mirror"]["rim_radius"],
+                            "R": a * a / b, "k": -1.0 - a * a / (b * b)}
+    asphere = omnical.Sensor.from_parameters(parameters)
+    assert asphere.profile == "even_asphere"
+    points = visible_points(svp, 500, seed=9)
+    pixels, status = svp.project(points)
+    twin_pixels, twin_status = asphere.project(points)
+    np.testing.assert_array_equal(status, twin_status)
+    ok = status == omnical.ProjectionStatus.OK
+    assert ok.sum() > 400
+    assert np.abs(pixels[ok] - twin_pixels[ok]).max() < 1e-9
+    parameters["mirror"]["k"] = 10.0  # an oblate ellipsoid that ends before the rim
+    with pytest.raises(omnical.InputError, match="R / sqrt"):
+        omnical.Sensor.from_parameters(parameters)

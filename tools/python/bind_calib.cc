@@ -22,6 +22,7 @@
 
 #include "calib/calibrate.h"
 #include "calib/calibration_json.h"
+#include "calib/fit_covariance.h"
 #include "calib/image_file.h"
 #include "calib/report/calibration_report.h"
 #include "model/input_error.h"
@@ -188,6 +189,12 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
         "Covariance of the free sensor parameters (poses marginalised), float64 (K, K), in covariance_names' order and "
         "the parameters' units.");
   field("per_view_rms_px", &CalibrationRecord::per_view_rms_px, "dict image -> RMS of its corners (px; NaN: left out).");
+  cls.def_property_readonly(
+      "correlation", [record](const Holder& holder) { return Eigen::MatrixXd(CorrelationOf(record(holder).covariance)); },
+      "The covariance as correlations, float64 (K, K), unit diagonal, in covariance_names' order.");
+  field("scale_block_condition", &CalibrationRecord::scale_block_condition,
+        "Condition number of the scale-like parameters' correlation block (focal, m, mirror size); NaN without a "
+        "covariance.");
   cls.def_property_readonly(
       "parameters",
       [record](const Holder& holder) {
@@ -604,8 +611,8 @@ list of paths or arrays, a dict name -> array) or detections (a Detections or a
 detections file), exactly one. guess: a Sensor or a sensor file (a file also brings its
 design tolerances, as --sensor); without one the fit starts from the mirror's rim circle
 (rim_field_deg: the rim ray's angle from the axis). profile: mirror family to fit
-(sphere, paraboloid, polynomial, hyperboloid; '' the guess's). fixed: blocks held
-(lens, lens_scale, distortion, m, tilt, decenter, shape, poses; a list or 'a,b').
+(one of omnical.PROFILES but tabulated; '' the guess's). fixed: blocks held (lens,
+lens_scale, principal_point, distortion, m, tilt, decenter, shape, poses; a list or 'a,b').
 loss_px: Huber scale (0: least squares). detection_passes: 2 re-detects through the
 first fit. threads: detection threads, 0 for all cores. leave_one_out: also fit without
 each view. tolerances: design tolerances (dict name -> one std, or 'name=value,...').

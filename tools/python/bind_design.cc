@@ -5,6 +5,7 @@
 // cmd_characterize.cc).
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -23,6 +24,7 @@
 #include "model/design/design_ode_job.h"
 #include "model/design/design_spec_yaml.h"
 #include "model/input_error.h"
+#include "model/model_registry.h"
 #include "model/io/atomic_write.h"
 #include "model/io/sensor_yaml.h"
 #include "tools/python/bindings.h"
@@ -405,8 +407,8 @@ measured through its own model (model/design/mirror_design_fit.h).)")
 (model/design/design_fit_job.h): the normalised parameters, the sensor in mm and the laws it achieves.)")
       .def_readonly("sensor", &DesignFitResult::sensor, "The designed axial Sensor (mm).")
       .def_property_readonly(
-          "profile", [](const DesignFitResult& r) { return ProfileFamilyName(r.spec.family); },
-          "The profile family: sphere, polynomial or hyperboloid.")
+          "profile", [](const DesignFitResult& r) { return r.spec.profile; },
+          "The profile family: one of omnical.DESIGN_PROFILES.")
       .def_property_readonly(
           "characteristic", [](const DesignFitResult& r) { return CharacteristicName(r.spec.characteristic); },
           "The characteristic fitted: none, equidistant, svp, aspect or area.")
@@ -458,20 +460,19 @@ design.json and the figures (characteristic.png, profile_drawing.svg/.png).)");
 
   m.def(
       "design_fit",
-      [](const std::string& profile, int polynomial_terms, double rim_omega_deg, double rim_theta_deg,
+      [](const std::string& profile, int terms, double rim_omega_deg, double rim_theta_deg,
          const py::object& characteristic, double rim_radius_mm, int image_size_px, const py::object& compare,
          int samples, int characteristic_samples, int profile_samples, py::object progress) {
         DesignFitOptions o;
-        if (profile != "sphere" && profile != "polynomial" && profile != "hyperboloid")
-          throw InputError("profile: must be sphere, polynomial or hyperboloid, not '" + profile + "'");
-        o.spec.family = profile == "sphere"        ? ProfileFamily::kSphere
-                        : profile == "hyperboloid" ? ProfileFamily::kHyperboloid
-                                                   : ProfileFamily::kPolynomial;
-        o.spec.polynomial_terms = polynomial_terms;
+        const std::vector<std::string> profiles = DesignProfileNames();
+        if (std::find(profiles.begin(), profiles.end(), profile) == profiles.end())
+          throw InputError("profile: must be " + JoinChoices(profiles) + ", not '" + profile + "'");
+        o.spec.profile = profile;
+        o.spec.terms = terms;
         o.spec.rim_omega_deg = rim_omega_deg;
         o.spec.rim_theta_deg = rim_theta_deg;
         o.spec.samples = samples;
-        o.spec.characteristic = DefaultCharacteristic(o.spec.family, polynomial_terms);
+        o.spec.characteristic = DefaultCharacteristic(profile, terms);
         if (!characteristic.is_none()) {
           const std::string name = py::str(characteristic);
           bool known = false;
@@ -501,15 +502,16 @@ design.json and the figures (characteristic.png, profile_drawing.svg/.png).)");
         o.progress = ForwardProgress(std::move(progress));
         return RunReleased([&] { return DesignMirrorFit(o); });
       },
-      py::kw_only(), "profile"_a, "polynomial_terms"_a = 3, "rim_omega_deg"_a = 135.0, "rim_theta_deg"_a = 12.0,
+      py::kw_only(), "profile"_a, "terms"_a = 3, "rim_omega_deg"_a = 135.0, "rim_theta_deg"_a = 12.0,
       "characteristic"_a = py::none(), "rim_radius_mm"_a = 43.9, "image_size_px"_a = 1000, "compare"_a = py::none(),
       "samples"_a = 200, "characteristic_samples"_a = 1000, "profile_samples"_a = 2000, "progress"_a = py::none(),
       R"(Ohte & Tsuzuki's design by parameters (Table 1), solved with Ceres (as `omnical design fit`).
 
-profile: sphere, polynomial or hyperboloid; polynomial_terms: c1 x^2 .. cn x^2n;
+profile: one of omnical.DESIGN_PROFILES; terms: how many terms the family's list has
+(polynomial c1 x^2 .. cn x^2n; see docs/file-formats.md for the others);
 rim_omega_deg / rim_theta_deg: the rim ray's Omega and the lens's Theta at the rim;
-characteristic: equidistant, svp, aspect, area or none (default: polynomial equidistant,
-hyperboloid svp, sphere none); rim_radius_mm scales the normalised design; image_size_px:
+characteristic: equidistant, svp, aspect, area or none (default: svp for a hyperboloid,
+equidistant for a family with freedom left after the rim targets, else none); rim_radius_mm scales the normalised design; image_size_px:
 the rim images at half of it; compare: another axial sensor (Sensor or file) measured the
 same way; samples: characteristic residuals of the fit; characteristic_samples: mirror
 radii the laws are measured at; profile_samples: intervals of the profile table.

@@ -118,6 +118,16 @@ void BindModel(py::module_& m) {
   for (int code = 0; code <= static_cast<int>(ProjectionStatus::kInvalidInput); ++code)
     names.append(StatusName(static_cast<ProjectionStatus>(code)));
   m.attr("_STATUS_NAMES") = names;
+  // The registry's choices (model/model_registry.h): what sensor files, calibrate(profile=)
+  // and design_fit(profile=) accept.
+  auto list_of = [](const std::vector<std::string>& names) {
+    py::list out;
+    for (const std::string& name : names) out.append(name);
+    return out;
+  };
+  m.attr("PROFILES") = list_of(ProfileNames());
+  m.attr("LENSES") = list_of(LensNames());
+  m.attr("DESIGN_PROFILES") = list_of(DesignProfileNames());
 
   py::class_<Sensor>(m, "Sensor", R"(A catadioptric sensor: lens (pinhole or orthographic), mirror profile and
 mirror pose, as in sensor.yaml (docs/file-formats.md "Sensor file").

@@ -1,0 +1,83 @@
+// What the bundle fit (calib/bundle_fit.h) refines and how: typed switches per block,
+// the robust loss and outlier rule, design tolerances and the Ceres solver's settings.
+#pragma once
+
+#include <ceres/solver.h>
+
+#include <map>
+#include <set>
+#include <string>
+
+#include "model/parameter_field.h"
+#include "model/progress.h"
+#include "model/sensor.h"
+
+namespace omnical {
+
+// Which parameters the fit moves, by the registry's groups (model/parameter_field.h);
+// a held one keeps the start's value. Held entries of a block become a SubsetManifold,
+// a block held whole is constant.
+struct RefineOptions {
+  bool focal = true;            // fx, fy of a pinhole; the scale of an orthographic lens
+  bool principal_point = true;  // cx, cy
+  bool distortion = true;       // k1, k2 of a pinhole
+  bool m = true;                // lens-to-vertex distance
+  bool tilt = true;
+  bool decenter = true;
+  bool shape = true;            // the profile's parameters
+  bool poses = true;            // the target's pose in every view
+
+  bool Refines(ParameterGroup group) const;
+  // Holds the blocks named as the CLI's --fix and Python's fixed= name them: lens (focal,
+  // principal point and distortion), lens_scale (focal), principal_point, distortion, m,
+  // tilt, decenter, shape, poses. Empty, or "fixed: unknown block '...' (...)".
+  std::string Hold(const std::set<std::string>& names);
+  // The held blocks by those names (lens for focal + principal point + distortion).
+  std::set<std::string> HeldNames() const;
+};
+
+// Ceres' settings for the bundle fit: dense QR (a few dozen sensor columns next to the
+// poses), tolerances near machine precision (the stages and the covariance want the true
+// minimum), two threads, silent.
+ceres::Solver::Options DefaultSolverOptions();
+
+struct FitOptions {
+  RefineOptions refine;
+  double robust_loss_px = 1.0;  // robust scale in px (Cauchy, outlier removal, then Huber); 0 = plain least squares
+  ceres::Solver::Options solver = DefaultSolverOptions();  // max_num_iterations is per stage
+  bool compute_covariance = true;
+  // Outliers (robust mode): |residual| beyond max(outlier_floor_px, outlier_sigmas x a
+  // robust sigma of the residuals) are removed. The floor keeps a very good fit (renders:
+  // 0.02 px) from throwing good corners away; 4 sigma of a 2-D Gaussian's |e| cuts 3e-4.
+  double outlier_floor_px = 0.5;
+  double outlier_sigmas = 4.0;
+  // A view whose inlier RMS exceeds max(outlier_floor_px, view_rms_ratio x the median of
+  // the views' RMS) is left out (robust mode): it shows something else than the other
+  // views' board. Real views differ by up to 2.5x (measured on the dev set).
+  double view_rms_ratio = 4.0;
+  // Design tolerances: one standard deviation of a Gaussian prior around the guess's value,
+  // per parameter name as FitResult names them (fx_px, cx_px, k1, m_mm, decenter_x_mm,
+  // A_mm, ...) or a pair: tilt_deg, decenter_mm, principal_point_px, focal_px. They pull
+  // the fit towards the design (a weak prior residual: the wrong basins of the camera
+  // rotation / decenter / distortion valley lie many tolerances away) and enter the
+  // covariance. A tolerance on a held parameter is ignored (FitResult::tolerance_notes
+  // says so); on a sphere with its tilt held, a tilt tolerance widens the decenter's.
+  std::map<std::string, double> tolerances;
+  // The design values the tolerances are centred on, by parameter name (reported units);
+  // a parameter not named here is centred on the guess's value. A pipeline that fits
+  // several times (a second detection pass from the first fit) keeps the user's design.
+  std::map<std::string, double> design;
+  // Stage "fit", one step per solver iteration; returning false cancels (Cancelled).
+  ProgressCallback progress;
+
+  // The gauge-fixing defaults for a sensor, from the registry's traits: an orthographic
+  // lens holds m, decenter and its scale; a profile whose tilt is not observable (a
+  // sphere) holds the tilt; free-form shape terms with a pinhole hold the distortion.
+  static FitOptions DefaultsFor(const Sensor& sensor);
+  // Empty if valid, else "field: problem".
+  std::string Check() const;
+  // Check() and the tolerance names against the sensor's parameters ("tolerances.x: ...").
+  std::string CheckFor(const Sensor& sensor) const;
+};
+
+}  // namespace omnical

@@ -1,0 +1,102 @@
+// The bundle fit's cost (calib/bundle_fit.h): the exact non-central reprojection error of
+// one target corner, for any registered lens x profile (model/model_registry.h).
+//
+// Parameter blocks, in this order (BlockSizes):
+//   lens        Lens::kNumParams, the lens's ToParams order
+//   m           1 (mm)
+//   tilt        2 (rad: x, y)
+//   decenter    2 (mm: x, y)
+//   shape       the profile's NumParams(), its ToParams order; absent when 0 (tabulated)
+//   rotation    4: camera_from_target as Eigen's quaternion coefficients x, y, z, w
+//   translation 3: camera_from_target (mm)
+// Residual: predicted minus observed pixel (2). Evaluation fails (returns false) where the
+// optics have no reflection point: Ceres then treats the step as invalid.
+#pragma once
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <vector>
+
+#include "model/catadioptric.h"
+
+namespace omnical {
+
+template <template <typename> class Profile, template <typename> class Lens>
+class ReprojectionCost {
+ public:
+  using Model = Catadioptric<double, Profile, Lens>;
+
+  // base: the rim, image size, the profile's parameter count (a tabulated profile's table).
+  ReprojectionCost(const Model& base, const Eigen::Vector3d& point_in_target_mm, const Eigen::Vector2d& observed_px)
+      : base_(base), point_in_target_mm_(point_in_target_mm), observed_px_(observed_px) {
+    // The corner was detected, so its reflection lies on the mirror; iterates may stray a
+    // little past the rim, where the profile is still defined.
+    base_.rim_radius_mm = std::min(1.15 * base.rim_radius_mm, 0.99 * base.mirror.MaxRadiusMm());
+  }
+
+  template <typename T>
+  bool operator()(T const* const* p, T* residual) const {
+    Catadioptric<T, Profile, Lens> model;
+    model.lens = Lens<T>::FromParams(p[0]);
+    model.pose = MirrorPose<T>{p[1][0], p[2][0], p[2][1], p[3][0], p[3][1]};
+    int next = 4;
+    model.mirror = HasShape() ? base_.mirror.template WithParams<T>(p[next++]) : base_.mirror.template Cast<T>();
+    model.rim_radius_mm = base_.rim_radius_mm;
+    model.image_width_px = base_.image_width_px;
+    model.image_height_px = base_.image_height_px;
+    const Eigen::Quaternion<T> rotation(p[next][3], p[next][0], p[next][1], p[next][2]);
+    const Vec3<T> in_camera =
+        rotation * point_in_target_mm_.cast<T>() + Vec3<T>(p[next + 1][0], p[next + 1][1], p[next + 1][2]);
+    Vec3<T> mirror_point;
+    // The corner was detected: no image-bounds or occlusion test, only the optics.
+    if (model.ReflectionPoint(in_camera, &mirror_point) != ProjectionStatus::kOk) return false;
+    Vec2<T> pixel;
+    if (!model.lens.ProjectToPixel(mirror_point, &pixel)) return false;
+    residual[0] = pixel(0) - T(observed_px_.x());
+    residual[1] = pixel(1) - T(observed_px_.y());
+    return true;
+  }
+
+  // The blocks' sizes, in the order above.
+  static std::vector<int> BlockSizes(const Model& base) {
+    std::vector<int> sizes = {Lens<double>::kNumParams, 1, 2, 2};
+    if (base.mirror.NumParams() > 0) sizes.push_back(base.mirror.NumParams());
+    sizes.push_back(4);
+    sizes.push_back(3);
+    return sizes;
+  }
+
+  // Automatic derivatives (Jets through the implicit solve: model/catadioptric.h).
+  static ceres::CostFunction* Create(const Model& base, const Eigen::Vector3d& point_in_target_mm,
+                                     const Eigen::Vector2d& observed_px) {
+    auto* cost = new ceres::DynamicAutoDiffCostFunction<ReprojectionCost, 8>(
+        new ReprojectionCost(base, point_in_target_mm, observed_px));
+    for (int size : BlockSizes(base)) cost->AddParameterBlock(size);
+    cost->SetNumResiduals(2);
+    return cost;
+  }
+
+  const Eigen::Vector3d& point_in_target_mm() const { return point_in_target_mm_; }
+
+ private:
+  bool HasShape() const { return base_.mirror.NumParams() > 0; }
+
+  Model base_;
+  Eigen::Vector3d point_in_target_mm_;
+  Eigen::Vector2d observed_px_;
+};
+
+// The cost of a model type. Deduced from the Catadioptric's own template arguments: clang
+// (unlike GCC) treats Model::ProfileOf, an alias template, as a template distinct from the
+// profile itself (CWG 1286), and the functor's model type would then mismatch.
+template <typename Model>
+struct ReprojectionCostOf;
+template <template <typename> class Profile, template <typename> class Lens>
+struct ReprojectionCostOf<Catadioptric<double, Profile, Lens>> {
+  using type = ReprojectionCost<Profile, Lens>;
+};
+
+}  // namespace omnical
