@@ -28,20 +28,8 @@ namespace {
 using testing::AllTestSensors;
 using testing::kRimMm;
 
-class EveryModel : public ::testing::TestWithParam<int> {
- protected:
-  const testing::NamedSensor& named() const {
-    static const std::vector<testing::NamedSensor> all = AllTestSensors();
-    return all[GetParam()];
-  }
-};
-
-std::string ModelName(const ::testing::TestParamInfo<int>& info) {
-  std::string name = AllTestSensors()[info.param].name;
-  for (char& c : name)
-    if (c == '/') c = '_';
-  return name;
-}
+using EveryModel = testing::EveryTestSensor;
+using testing::TestSensorName;
 
 // A target point seen by the model: along the ray of `pixel`, `distance_mm` from the
 // mirror, expressed in a target frame turned and shifted against the camera.
@@ -367,7 +355,7 @@ TEST(FitCovariance, AgreesWithAMonteCarloOverNoisyObservations) {
                                                           std::to_string(median(reported_fx_m)));
 }
 
-INSTANTIATE_TEST_SUITE_P(Models, EveryModel, ::testing::Range(0, static_cast<int>(AllTestSensors().size())), ModelName);
+INSTANTIATE_TEST_SUITE_P(Models, EveryModel, ::testing::Range(0, static_cast<int>(AllTestSensors().size())), TestSensorName);
 
 }  // namespace
 }  // namespace omnical

@@ -14,20 +14,8 @@ namespace {
 using testing::AllTestSensors;
 using testing::kRimMm;
 
-class EveryModel : public ::testing::TestWithParam<int> {
- protected:
-  const testing::NamedSensor& named() const {
-    static const std::vector<testing::NamedSensor> all = AllTestSensors();
-    return all[GetParam()];
-  }
-};
-
-std::string ModelName(const ::testing::TestParamInfo<int>& info) {
-  std::string name = AllTestSensors()[info.param].name;
-  for (char& c : name)
-    if (c == '/') c = '_';
-  return name;
-}
+using EveryModel = testing::EveryTestSensor;
+using testing::TestSensorName;
 
 // Projection after unprojection returns the pixel to < 1e-6 px over the whole image, for
 // points from 1e-3 (0.04 mm from the mirror) to 1000 rim radii along each ray. The solver's own tolerance is
@@ -121,7 +109,7 @@ TEST_P(EveryModel, BatchProjectionMatchesScalar) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, EveryModel, ::testing::Range(0, static_cast<int>(AllTestSensors().size())),
-                         ModelName);
+                         TestSensorName);
 
 // Where a ray crosses the mirror axis, for an axial sensor (camera frame).
 double AxisCrossingZ(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double* miss_mm) {

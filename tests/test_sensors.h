@@ -93,6 +93,23 @@ inline std::vector<NamedSensor> AllTestSensors() {
   return all;
 }
 
+// A test over every test sensor: INSTANTIATE_TEST_SUITE_P(Models, Fixture,
+// ::testing::Range(0, AllTestSensors().size()), TestSensorName).
+class EveryTestSensor : public ::testing::TestWithParam<int> {
+ protected:
+  const NamedSensor& named() const {
+    static const std::vector<NamedSensor> all = AllTestSensors();
+    return all[GetParam()];
+  }
+};
+
+inline std::string TestSensorName(const ::testing::TestParamInfo<int>& info) {
+  std::string name = AllTestSensors()[info.param].name;
+  for (char& c : name)
+    if (c == '/') c = '_';
+  return name;
+}
+
 // Whether every model type of the registry (model/model_registry.h) has an aligned and a
 // misaligned test sensor: a profile registered without one fails ModelRegistry tests.
 inline std::string ModelTypesWithoutTestSensor() {
