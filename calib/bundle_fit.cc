@@ -207,24 +207,22 @@ class FitRun {
     });
     std::map<std::string, double> tolerance_of = ExpandTolerances(options_.tolerances);
     // A sphere's tilt is its gauge (held by default): the fitted decenter is then the
-    // offset of its centre, decenter + A (cos tx sin ty, -sin tx), which the design's tilt
-    // error moves too. A tilt tolerance therefore widens the decenter's:
-    // sigma_x^2 + (A sigma_ty)^2.
-    if constexpr (std::is_same_v<typename Model::ProfileType, SphereProfile<double>>) {
-      if (!options_.refine.tilt) {
-        const double radius_mm = guess_.mirror.radius_of_curvature_mm;
-        for (const auto& [tilt_name, decenter_name] : {std::pair<std::string, std::string>{"tilt_y_deg", "decenter_x_mm"},
-                                                       {"tilt_x_deg", "decenter_y_mm"}}) {
-          const auto tilt_tolerance = tolerance_of.find(tilt_name);
-          if (tilt_tolerance == tolerance_of.end()) continue;
-          const double widened = radius_mm * tilt_tolerance->second / kDeg;
-          double& decenter_tolerance = tolerance_of[decenter_name];  // 0 if none was given
-          decenter_tolerance = std::hypot(decenter_tolerance, widened);
-          result_.tolerance_notes.push_back(tilt_name + "'s tolerance widens " + decenter_name + "'s to " +
-                                            FormatNumber(decenter_tolerance) +
-                                            " mm (a sphere's tilt is held: its centre is what the data see)");
-          tolerance_of.erase(tilt_tolerance);
-        }
+    // offset of its centre, decenter + R (cos tx sin ty, -sin tx) with R the vertex radius
+    // of curvature, which the design's tilt error moves too. A tilt tolerance therefore
+    // widens the decenter's: sigma_x^2 + (R sigma_ty)^2.
+    if (!guess_.mirror.TiltObservable() && !options_.refine.tilt) {
+      const double radius_mm = 0.5 / guess_.mirror.template EvaluateSag<double>(0.0).dz_ds;
+      for (const auto& [tilt_name, decenter_name] : {std::pair<std::string, std::string>{"tilt_y_deg", "decenter_x_mm"},
+                                                     {"tilt_x_deg", "decenter_y_mm"}}) {
+        const auto tilt_tolerance = tolerance_of.find(tilt_name);
+        if (tilt_tolerance == tolerance_of.end()) continue;
+        const double widened = radius_mm * tilt_tolerance->second / kDeg;
+        double& decenter_tolerance = tolerance_of[decenter_name];  // 0 if none was given
+        decenter_tolerance = std::hypot(decenter_tolerance, widened);
+        result_.tolerance_notes.push_back(tilt_name + "'s tolerance widens " + decenter_name + "'s to " +
+                                          FormatNumber(decenter_tolerance) +
+                                          " mm (a sphere's tilt is held: its centre is what the data see)");
+        tolerance_of.erase(tilt_tolerance);
       }
     }
     for (const auto& [name, tolerance] : tolerance_of) {

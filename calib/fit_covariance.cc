@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "calib/fit_options.h"
+
 namespace omnical {
 
 bool EstimateCovariance(ceres::Problem* problem, const std::vector<double*>& variable_blocks,
@@ -87,7 +89,18 @@ std::vector<CovarianceFinding> WeakParameters(const std::vector<CovarianceParame
   for (size_t k = 0; k < parameters.size(); ++k) {
     const CovarianceParameter& p = parameters[k];
     const double std = std::sqrt(std::max(0.0, covariance(k, k)));
-    if (!p.scale_like || p.value == 0.0 || !(std > 0.05 * std::abs(p.value))) continue;
+    // Scale-like: relative to the value. A tilt: beyond 2 deg it is not determined at all
+    // (a nearly spherical mirror turned about its centre; the bundled sets reach 1.1 deg
+    // at worst).
+    const bool weak = p.scale_like ? p.value != 0.0 && std > 0.05 * std::abs(p.value)
+                                    : p.group == ParameterGroup::kTilt && std > kWeakTiltStdDeg;
+    if (!weak) continue;
+    char spread[80];
+    if (p.scale_like) {
+      std::snprintf(spread, sizeof spread, "std %.1f%% of its value", 100.0 * std / std::abs(p.value));
+    } else {
+      std::snprintf(spread, sizeof spread, "std %.2g deg", std);
+    }
     int partner = -1;
     for (size_t j = 0; j < parameters.size(); ++j)
       if (parameters[j].group != p.group && (partner < 0 || std::abs(correlation(k, j)) > std::abs(correlation(k, partner))))
@@ -97,15 +110,15 @@ std::vector<CovarianceFinding> WeakParameters(const std::vector<CovarianceParame
     // of the variance); a weak correlation would mislead.
     if (partner >= 0 && std::abs(correlation(k, partner)) >= 0.9) {
       std::snprintf(text, sizeof text,
-                    "%s is weakly determined (std %.1f%% of its value): it trades off with %s (correlation %.3f); hold "
-                    "one of them at its design value (--fix) or give it a tolerance, or add views at more distances",
-                    p.name.c_str(), 100.0 * std / std::abs(p.value), parameters[partner].name.c_str(),
-                    correlation(k, partner));
+                    "%s is weakly determined (%s): it trades off with %s (correlation %.3f); hold %s or %s at its "
+                    "design value (--fix %s or --fix %s), give a design tolerance, or add views at more distances",
+                    p.name.c_str(), spread, parameters[partner].name.c_str(), correlation(k, partner),
+                    HoldName(p.group), HoldName(parameters[partner].group), HoldName(p.group),
+                    HoldName(parameters[partner].group));
     } else {
       std::snprintf(text, sizeof text,
-                    "%s is weakly determined (std %.1f%% of its value): views covering more of the mirror, at more "
-                    "distances, help",
-                    p.name.c_str(), 100.0 * std / std::abs(p.value));
+                    "%s is weakly determined (%s): views covering more of the mirror, at more distances, help",
+                    p.name.c_str(), spread);
     }
     findings.push_back({p.name, text});
   }

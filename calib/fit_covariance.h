@@ -45,7 +45,10 @@ struct CovarianceParameter {
   bool scale_like;
 };
 
-// The free scale-like parameters whose std exceeds 5 % of their value (the others are
+constexpr double kWeakTiltStdDeg = 2.0;
+
+// The free scale-like parameters whose std exceeds 5 % of their value, and tilts known to
+// no better than kWeakTiltStdDeg (the others are
 // naturally near zero, where a relative std means nothing), each named with the parameter
 // of another group it is most correlated with when that correlation is >= 0.9: the valley
 // it moves along (fx with m is the

@@ -19,6 +19,19 @@ bool RefineOptions::Refines(ParameterGroup group) const {
   return true;
 }
 
+const char* HoldName(ParameterGroup group) {
+  switch (group) {
+    case ParameterGroup::kFocal: return "lens_scale";
+    case ParameterGroup::kPrincipalPoint: return "principal_point";
+    case ParameterGroup::kDistortion: return "distortion";
+    case ParameterGroup::kMirrorDistance: return "m";
+    case ParameterGroup::kTilt: return "tilt";
+    case ParameterGroup::kDecenter: return "decenter";
+    case ParameterGroup::kShape: return "shape";
+  }
+  return "?";
+}
+
 std::string RefineOptions::Hold(const std::set<std::string>& names) {
   for (const std::string& name : names) {
     if (name == "lens") {
@@ -86,7 +99,7 @@ FitOptions FitOptions::DefaultsFor(const Sensor& sensor) {
         if constexpr (Model::kOrthographic) options.refine.m = options.refine.decenter = options.refine.focal = false;
         // A sphere turned about its own centre is the same surface (only its rim moves):
         // its tilt is not observable; its centre, R (0, 0, A) + (dx, dy, m), is.
-        if constexpr (!Model::ProfileType::kTiltObservable) options.refine.tilt = false;
+        if (!model.mirror.TiltObservable()) options.refine.tilt = false;
         // Free-form mirror terms bend the radial mapping as the lens's radial distortion
         // does: k1, k2 are held and the mirror shape absorbs them. (fx stays observable but
         // weakly: another fx with other terms looks almost the same; see docs/calibrate.md

@@ -36,6 +36,9 @@ struct RefineOptions {
   std::set<std::string> HeldNames() const;
 };
 
+// The block name that holds a group (--fix, Python's fixed=, RefineOptions::Hold).
+const char* HoldName(ParameterGroup group);
+
 // Ceres' settings for the bundle fit: dense QR (a few dozen sensor columns next to the
 // poses), tolerances near machine precision (the stages and the covariance want the true
 // minimum), two threads, silent.
@@ -72,7 +75,7 @@ struct FitOptions {
 
   // The gauge-fixing defaults for a sensor, from the registry's traits: an orthographic
   // lens holds m, decenter and its scale; a profile whose tilt is not observable (a
-  // sphere) holds the tilt; free-form shape terms with a pinhole hold the distortion.
+  // sphere, an even asphere with k = 0 and no terms) holds the tilt; free-form shape terms with a pinhole hold the distortion.
   static FitOptions DefaultsFor(const Sensor& sensor);
   // Empty if valid, else "field: problem".
   std::string Check() const;

@@ -25,7 +25,8 @@ struct SagResidual {
     const SagDerivatives<T> g = shape.template WithParams<T>(params[0]).EvaluateSag(T(r2));
     residual[0] = g.z - T(z_mm);
     residual[1] = (T(2.0 * std::sqrt(r2)) * g.dz_ds) * T(rim_mm) - T(slope_times_rim_mm);
-    return true;
+    // Beyond the family's domain (a conic that ends before this radius): an invalid step.
+    return std::isfinite(ScalarPart(residual[0])) && std::isfinite(ScalarPart(residual[1]));
   }
 };
 

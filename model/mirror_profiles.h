@@ -44,11 +44,12 @@ struct SphereProfile {
   static constexpr std::array<ParameterField, 1> kFields{
       {ScalarField("A", "A_mm", ParameterGroup::kShape, true, FieldDomain::kPositive, 1e7, 1)}};
   static constexpr int kMaxParams = 1;
-  // Turned about its own centre a sphere is the same surface: its tilt is its gauge.
-  static constexpr bool kTiltObservable = false;
+
   T radius_of_curvature_mm;
 
   int NumParams() const { return 1; }
+  // Turned about its own centre a sphere is the same surface: its tilt is its gauge.
+  bool TiltObservable() const { return false; }
 
   template <typename S>
   SagDerivatives<S> EvaluateSag(const S& r2) const {
@@ -95,11 +96,11 @@ struct EvenPolynomialProfile {
   static constexpr std::array<ParameterField, 1> kFields{
       {TermList("coefficients", "c", 1, kMaxCoefficients, 1, 1, -1, -2, std::numeric_limits<double>::infinity(), true)}};
   static constexpr int kMaxParams = kMaxCoefficients;
-  static constexpr bool kTiltObservable = true;
   std::array<T, kMaxCoefficients> coefficients{};
   int num_coefficients = 0;
 
   int NumParams() const { return num_coefficients; }
+  bool TiltObservable() const { return true; }
   template <typename S>
   SagDerivatives<S> EvaluateSag(const S& r2) const {
     // Horner on g(s) = s * (c1 + s * (c2 + ...)) with its first two derivatives.
@@ -164,11 +165,11 @@ struct HyperboloidProfile {
       {ScalarField("A", "A_mm", ParameterGroup::kShape, true, FieldDomain::kPositive, 1e7, 1),
        ScalarField("B", "B_mm", ParameterGroup::kShape, true, FieldDomain::kPositive, 1e7, 1)}};
   static constexpr int kMaxParams = 2;
-  static constexpr bool kTiltObservable = true;
   T a_mm;
   T b_mm;
 
   int NumParams() const { return 2; }
+  bool TiltObservable() const { return true; }
 
   template <typename S>
   SagDerivatives<S> EvaluateSag(const S& r2) const {
@@ -216,10 +217,10 @@ struct ParaboloidProfile {
   static constexpr std::array<ParameterField, 1> kFields{
       {ScalarField("A", "A_mm", ParameterGroup::kShape, true, FieldDomain::kPositive, 1e7, 1)}};
   static constexpr int kMaxParams = 1;
-  static constexpr bool kTiltObservable = true;
   T focal_distance_mm;
 
   int NumParams() const { return 1; }
+  bool TiltObservable() const { return true; }
 
   template <typename S>
   SagDerivatives<S> EvaluateSag(const S& r2) const {

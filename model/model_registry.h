@@ -15,7 +15,7 @@
 //                             file's key, the fit's name, group, domain, length power
 //   kMaxParams, NumParams()   how many (0 for a tabulated profile, never fitted)
 //   kRimSlopeParam            the parameter SolveRimSlope sets (-1: not a design family)
-//   kTiltObservable           false where a turned mirror is the same surface (a sphere)
+//   TiltObservable()          false where a turned mirror is the same surface (a sphere)
 //   FromParams(p, count), ToParams(p), WithParams<U>(p)   the parameters as a flat array
 //   FromVertexRadius(R, rim)  the family's member nearest a sphere of vertex radius R
 //   SolveRimSlope<U>(p, count, slope)   sets kRimSlopeParam so that f'(1) = slope

@@ -93,11 +93,11 @@ struct TabulatedProfile {
   static constexpr std::array<ParameterField, 0> kFields{};
   static constexpr int kMaxParams = 0;
   static constexpr int kRimSlopeParam = -1;  // not a design family
-  static constexpr bool kTiltObservable = true;
   std::shared_ptr<const ProfileSpline> spline;
   std::string source;  // the CSV it came from, written back by the sensor writer
 
   int NumParams() const { return 0; }
+  bool TiltObservable() const { return true; }
   void ToParams(T* /*params*/) const {}
   template <typename U>
   TabulatedProfile<U> WithParams(const U* /*params*/) const {

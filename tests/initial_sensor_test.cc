@@ -26,7 +26,7 @@ TEST(SensorFromRimCircle, PutsTheRimRayWhereAsked) {
   RimCircle rim;
   rim.centre_px = Eigen::Vector2d(641.0, 521.5);
   rim.radius_px = 352.0;
-  for (const std::string profile : {"paraboloid", "polynomial", "sphere"})
+  for (const std::string profile : {"paraboloid", "polynomial", "sphere", "even_asphere"})
     for (double field_deg : {95.0, 105.0, 120.0}) {
       const Sensor sensor = SensorFromRimCircle(rim, 1280, 1024, profile, field_deg);
       EXPECT_STREQ(sensor.profile_name(), profile.c_str());
@@ -62,7 +62,14 @@ TEST(ConvertProfile, SeesTheSceneAsTheGuessDoes) {
   for (const Case& c : std::vector<Case>{{"ohte-sph", "polynomial", 12.0},
                                          {"ohte-sph", "paraboloid", 100.0},
                                          {"ohte-sph", "hyperboloid", 110.0},
-                                         {"ohte-svp", "polynomial", 5.0}}) {
+                                         {"ohte-svp", "polynomial", 5.0},
+                                         // The even asphere holds the sphere (k = 0) and the
+                                         // hyperboloid exactly: the fit from its paraboloid
+                                         // start must find them (1e-3 px: the sag fit's
+                                         // tolerance, 1e-14, not the families).
+                                         {"ohte-sph", "even_asphere", 1e-3},
+                                         {"ohte-svp", "even_asphere", 1e-3},
+                                         {"ohte-edi", "even_asphere", 12.0}}) {
     const Sensor guess = LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/" + c.sensor + ".yaml");
     const Sensor converted = ConvertProfile(guess, c.profile);
     EXPECT_STREQ(converted.profile_name(), c.profile.c_str());

@@ -140,15 +140,19 @@ FitDesign FitFamily(const FitDesignSpec& spec, const ProgressCallback& progress)
   FitDesign design;
   design.profile = Profile::kName;
   design.free_params = family.NumParams() - 1;
-  // Starting points: the free parameters at 0 but those that must be positive at 1 (one
-  // mirror radius): the polynomial starts from the parabola through the rim slope, the
-  // hyperboloid from A = 1.
+  // Starting points: the family's member nearest a sphere of one mirror radius
+  // (FromVertexRadius), further terms at 0: the polynomial starts from the parabola through
+  // the rim slope, the hyperboloid from A = 1, the even asphere from the paraboloid.
+  const Profile near_sphere = Profile::FromVertexRadius(1.0, 1.0);
+  std::vector<double> start(std::max(near_sphere.NumParams(), family.NumParams()), 0.0);
+  near_sphere.ToParams(start.data());
   std::vector<double> free;
   std::vector<bool> positive;
   ForEachProfileParameter<Profile>(family.NumParams(), [&](const ParameterField& field, int, int index) {
     if (index == Profile::kRimSlopeParam) return;
     positive.push_back(field.domain == FieldDomain::kPositive);
-    free.push_back(positive.back() ? 1.0 : 0.0);
+    const bool beyond_start = index >= near_sphere.NumParams() || index >= static_cast<int>(start.size());
+    free.push_back(beyond_start ? 0.0 : start[index]);
   });
   if (design.free_params > 0) {
     auto* cost = new ceres::DynamicAutoDiffCostFunction<CharacteristicResiduals<Profile>, 4>(
@@ -243,8 +247,8 @@ std::string FitDesignSpec::Check() const {
     using Profile = typename decltype(tag)::type::ProfileType;
     const ParameterField& last = Profile::kFields.back();
     if (last.is_list() && (terms < last.min_count || terms > last.max_count))
-      terms_problem = "terms: a " + profile + " has " + std::to_string(last.min_count) + " to " +
-                      std::to_string(last.max_count) + " terms";
+      terms_problem = "terms: must be " + std::to_string(last.min_count) + " to " + std::to_string(last.max_count) +
+                      " for a " + profile;
   });
   if (!known) return "profile: must be " + JoinChoices(DesignProfileNames()) + ", not '" + profile + "'";
   if (!terms_problem.empty()) return terms_problem;

@@ -113,29 +113,38 @@ MirrorPose<double> ReadPose(const FieldReader& reader, const YAML::Node& root) {
 }
 
 // The registered model of the file's lens and profile, every field read through the
-// registry's descriptions (a tabulated profile reads its table).
+// registry's descriptions (a tabulated profile reads its table). Sections in the order
+// camera, pose, mirror: the first problem found is the one reported.
 SensorModel ReadModel(const FieldReader& reader, const YAML::Node& root) {
   const SectionsRead read = ReadCommon(reader, root);
   const YAML::Node camera = root["camera"];
+  std::vector<double> lens;
+  bool lens_read = false;
+  ForEachModelType([&](auto tag) {
+    using Lens = typename decltype(tag)::type::LensType;
+    if (lens_read || read.lens != Lens::kName) return;
+    lens_read = true;
+    reader.RejectUnknown(camera, "camera", Keys(Lens::kFields, {"model", "image_size", "body_radius_mm"}));
+    lens = ReadFields(reader, camera, "camera", Lens::kFields.data(), Lens::kFields.size());
+    if (const std::string why = Lens::FromParams(lens.data()).CheckDomain(); !why.empty()) FailDomain(reader, "camera", why);
+  });
+  const MirrorPose<double> pose = ReadPose(reader, root);
   const YAML::Node mirror = reader.Section(root, "mirror");
   const std::string profile = reader.Text(mirror["profile"], "mirror.profile");
   const std::vector<std::string> profiles = ProfileNames();
   if (std::find(profiles.begin(), profiles.end(), profile) == profiles.end())
     reader.Fail("mirror.profile", "unknown profile '" + profile + "' (expected " + JoinChoices(profiles) + ")");
+  const double rim_mm = reader.Positive(mirror["rim_radius"], "mirror.rim_radius", 1e5);
+  if (rim_mm < 1e-3) reader.Fail("mirror.rim_radius", "must be >= 1e-3 mm");
   std::optional<SensorModel> model;
   ForEachModelType([&](auto tag) {
     using Model = typename decltype(tag)::type;
-    using Lens = typename Model::LensType;
     using Profile = typename Model::ProfileType;
-    if (model || read.lens != Lens::kName || profile != Profile::kName) return;
-    reader.RejectUnknown(camera, "camera", Keys(Lens::kFields, {"model", "image_size", "body_radius_mm"}));
+    if (model || read.lens != Model::LensType::kName || profile != Profile::kName) return;
     Model m;
-    const std::vector<double> lens = ReadFields(reader, camera, "camera", Lens::kFields.data(), Lens::kFields.size());
-    m.lens = Lens::FromParams(lens.data());
-    if (const std::string why = m.lens.CheckDomain(); !why.empty()) FailDomain(reader, "camera", why);
-    m.pose = ReadPose(reader, root);
-    m.rim_radius_mm = reader.Positive(mirror["rim_radius"], "mirror.rim_radius", 1e5);
-    if (m.rim_radius_mm < 1e-3) reader.Fail("mirror.rim_radius", "must be >= 1e-3 mm");
+    m.lens = Model::LensType::FromParams(lens.data());
+    m.pose = pose;
+    m.rim_radius_mm = rim_mm;
     if constexpr (kFittedProfile<Profile>) {
       reader.RejectUnknown(mirror, "mirror", Keys(Profile::kFields, {"profile", "rim_radius"}));
       const std::vector<double> shape = ReadFields(reader, mirror, "mirror", Profile::kFields.data(), Profile::kFields.size());
