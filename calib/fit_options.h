@@ -75,7 +75,7 @@ struct FitOptions {
 
   // The gauge-fixing defaults for a sensor, from the registry's traits: an orthographic
   // lens holds m, decenter and its scale; a profile whose tilt is not observable (a
-  // sphere, an even asphere with k = 0 and no terms) holds the tilt; free-form shape terms with a pinhole hold the distortion.
+  // sphere: TiltObservable()) holds the tilt; free-form shape terms with a pinhole hold the distortion.
   static FitOptions DefaultsFor(const Sensor& sensor);
   // Empty if valid, else "field: problem".
   std::string Check() const;

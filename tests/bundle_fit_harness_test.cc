@@ -140,7 +140,9 @@ TEST_P(EveryModel, ReprojectionCostPassesTheGradientChecker) {
             ++probes;
           }
         }
-        ::testing::Test::RecordProperty("maximum_relative_error", std::to_string(worst));
+        char worst_text[32];
+        std::snprintf(worst_text, sizeof worst_text, "%.3g", worst);
+        ::testing::Test::RecordProperty("maximum_relative_error", worst_text);
         EXPECT_EQ(probes, 6);
       },
       sensor.model());

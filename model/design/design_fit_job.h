@@ -36,7 +36,7 @@ struct DesignFitOptions {
 
 // The characteristic a family is usually shaped for: single viewpoint for a hyperboloid,
 // equidistant for any other with freedom left after the rim targets (a polynomial of two
-// or more terms, an even asphere), none for a sphere, a paraboloid or one term.
+// or more terms), none for a family the rim targets fix (a sphere, a one-term polynomial).
 ImageCharacteristic DefaultCharacteristic(const std::string& profile, int terms);
 
 struct DesignFitResult {

@@ -142,7 +142,7 @@ FitDesign FitFamily(const FitDesignSpec& spec, const ProgressCallback& progress)
   design.free_params = family.NumParams() - 1;
   // Starting points: the family's member nearest a sphere of one mirror radius
   // (FromVertexRadius), further terms at 0: the polynomial starts from the parabola through
-  // the rim slope, the hyperboloid from A = 1, the even asphere from the paraboloid.
+  // the rim slope, the hyperboloid from A = 1.
   const Profile near_sphere = Profile::FromVertexRadius(1.0, 1.0);
   std::vector<double> start(std::max(near_sphere.NumParams(), family.NumParams()), 0.0);
   near_sphere.ToParams(start.data());

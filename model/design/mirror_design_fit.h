@@ -1,7 +1,6 @@
 // Mirror design by parameters (Ohte & Tsuzuki 2012, Sec. 3.1 and Table 1), solved with
 // Ceres instead of the paper's trial and error: a profile family of the registry (every
-// profile with a kRimSlopeParam: sphere, even polynomial, hyperboloid, paraboloid, even
-// asphere; model/model_registry.h) whose rim ray has exactly the target Omega and Theta,
+// profile with a kRimSlopeParam, model/model_registry.h) whose rim ray has exactly the target Omega and Theta,
 // and whose image follows a characteristic (equidistant, single viewpoint, constant aspect
 // ratio, equal area) as closely as the family allows.
 //
@@ -12,8 +11,8 @@
 //   tan(beta_rim) = f'(1) with beta_rim = (Omega_rim - Theta_rim) / 2   (Eq. 4)
 //   m = 1 / tan(Theta_rim) - f(1)                                          (Eq. 5)
 // A sphere or paraboloid has no freedom left (A and m follow in closed form), a
-// hyperboloid one (A), an n-term polynomial n - 1 (c2..cn), an even asphere with n terms
-// n + 1 (k, a4, ...): each profile's SolveRimSlope sets the one parameter the slope fixes.
+// hyperboloid one (A), an n-term polynomial n - 1 (c2..cn): each profile's SolveRimSlope
+// sets the one parameter the slope fixes.
 #pragma once
 
 #include <string>
@@ -35,8 +34,8 @@ const char* CharacteristicName(ImageCharacteristic characteristic);
 
 struct FitDesignSpec {
   std::string profile = "polynomial";  // one of DesignProfileNames() (model/model_registry.h)
-  // The profile's list of terms (polynomial: c1 x^2 + ... + cn x^2n, Table 1's E-DI: 3;
-  // even asphere: a4 x^4 ...); ignored by a profile without one.
+  // The length of the profile's list of terms (polynomial: c1 x^2 + ... + cn x^2n, Table
+  // 1's E-DI: 3); ignored by a profile without one.
   int terms = 3;
   double rim_omega_deg = 135.0;
   double rim_theta_deg = 12.0;
@@ -49,7 +48,7 @@ struct FitDesignSpec {
 struct FitDesign {
   std::string profile;
   // Normalised parameters as Table 1 prints them: sphere {A}; hyperboloid {A, B};
-  // polynomial {c1, ..., cn} (the table's A, B, C for n = 3); even asphere {R, k, a4, ..}.
+  // polynomial {c1, ..., cn} (the table's A, B, C for n = 3); any family: its fields' order.
   std::vector<double> params;
   std::vector<std::string> names;     // sensor-file keys (A, B, R, k) or terms (c1, a4)
   std::vector<std::string> mm_names;  // the same in mm: A_mm, c2_per_mm3, k, a4_per_mm3
