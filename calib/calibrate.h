@@ -44,7 +44,7 @@ struct CalibrationInput {
 struct CalibrationOptions {
   std::string profile;  // mirror family to fit ("": the guess's; polynomial without a guess)
   double rim_field_deg = kDefaultRimFieldDeg;
-  std::set<std::string> fixed;  // FitOptions::fixed block names
+  std::set<std::string> fixed;  // blocks held, by RefineOptions::Hold's names (calib/fit_options.h)
   double loss_px = 1.0;
   int max_iterations = 200;
   int detection_passes = 2;
