@@ -76,17 +76,4 @@ struct ParameterInfo {
   bool free_form;
 };
 
-inline const char* ParameterGroupName(ParameterGroup group) {
-  switch (group) {
-    case ParameterGroup::kFocal: return "focal";
-    case ParameterGroup::kPrincipalPoint: return "principal_point";
-    case ParameterGroup::kDistortion: return "distortion";
-    case ParameterGroup::kMirrorDistance: return "m";
-    case ParameterGroup::kTilt: return "tilt";
-    case ParameterGroup::kDecenter: return "decenter";
-    case ParameterGroup::kShape: return "shape";
-  }
-  return "?";
-}
-
 }  // namespace omnical
