@@ -130,13 +130,21 @@ TEST_P(EveryModel, ReprojectionCostPassesTheGradientChecker) {
             ceres::NumericDiffOptions numeric;
             numeric.ridders_relative_initial_step_size = 1e-4;
             const ceres::GradientChecker checker(&scaled, &manifolds, numeric);
+            // The residual is the offset put on the observation.
+            EXPECT_NEAR(plain[0], -0.3, 1e-7);
+            EXPECT_NEAR(plain[1], 0.2, 1e-7);
+#ifndef __SANITIZE_ADDRESS__
             ceres::GradientChecker::ProbeResults results;
             EXPECT_TRUE(checker.Probe(parameters.data(), 1e-5, &results))
                 << named().name << " pixel " << pixel.transpose() << " at " << distance_mm << " mm: " << results.error_log;
-            // The residual is the offset put on the observation.
-            EXPECT_NEAR(results.residuals(0), -0.3, 1e-7);
-            EXPECT_NEAR(results.residuals(1), 0.2, 1e-7);
             worst = std::max(worst, results.maximum_relative_error);
+#else
+            // ProbeResults holds Eigen matrices that libceres (built without ASan) allocates
+            // and this unit would free: under ASan Eigen switches to its own aligned
+            // allocator (Memory.h), a mismatch. Ceres keeps its own results when given none.
+            EXPECT_TRUE(checker.Probe(parameters.data(), 1e-5, nullptr))
+                << named().name << " pixel " << pixel.transpose() << " at " << distance_mm << " mm";
+#endif
             ++probes;
           }
         }
