@@ -1,60 +1,58 @@
 #include "calib/fit_options.h"
 
 #include <cmath>
+#include <iterator>
 
 #include "model/model_registry.h"
 
 namespace omnical {
 
-bool RefineOptions::Refines(ParameterGroup group) const {
-  switch (group) {
-    case ParameterGroup::kFocal: return focal;
-    case ParameterGroup::kPrincipalPoint: return principal_point;
-    case ParameterGroup::kDistortion: return distortion;
-    case ParameterGroup::kMirrorDistance: return m;
-    case ParameterGroup::kTilt: return tilt;
-    case ParameterGroup::kDecenter: return decenter;
-    case ParameterGroup::kShape: return shape;
-  }
-  return true;
+namespace {
+
+// Each refine switch with the block name --fix holds it by and the parameter group it
+// moves: the one place the names live. "lens" holds the first three together.
+struct RefineSwitch {
+  const char* name;
+  bool RefineOptions::*member;
+  ParameterGroup group;
+  bool is_group;  // poses move no sensor parameter
+};
+constexpr RefineSwitch kSwitches[] = {
+    {"lens_scale", &RefineOptions::focal, ParameterGroup::kFocal, true},
+    {"principal_point", &RefineOptions::principal_point, ParameterGroup::kPrincipalPoint, true},
+    {"distortion", &RefineOptions::distortion, ParameterGroup::kDistortion, true},
+    {"m", &RefineOptions::m, ParameterGroup::kMirrorDistance, true},
+    {"tilt", &RefineOptions::tilt, ParameterGroup::kTilt, true},
+    {"decenter", &RefineOptions::decenter, ParameterGroup::kDecenter, true},
+    {"shape", &RefineOptions::shape, ParameterGroup::kShape, true},
+    {"poses", &RefineOptions::poses, ParameterGroup::kShape, false},
+};
+constexpr int kLensSwitches = 3;
+
+const RefineSwitch& SwitchOf(ParameterGroup group) {
+  for (const RefineSwitch& s : kSwitches)
+    if (s.is_group && s.group == group) return s;
+  return kSwitches[0];  // unreachable: every group has a switch
 }
 
-const char* HoldName(ParameterGroup group) {
-  switch (group) {
-    case ParameterGroup::kFocal: return "lens_scale";
-    case ParameterGroup::kPrincipalPoint: return "principal_point";
-    case ParameterGroup::kDistortion: return "distortion";
-    case ParameterGroup::kMirrorDistance: return "m";
-    case ParameterGroup::kTilt: return "tilt";
-    case ParameterGroup::kDecenter: return "decenter";
-    case ParameterGroup::kShape: return "shape";
-  }
-  return "?";
-}
+}  // namespace
+
+bool RefineOptions::Refines(ParameterGroup group) const { return this->*SwitchOf(group).member; }
+
+const char* HoldName(ParameterGroup group) { return SwitchOf(group).name; }
 
 std::string RefineOptions::Hold(const std::set<std::string>& names) {
   for (const std::string& name : names) {
-    if (name == "lens") {
-      focal = principal_point = distortion = false;
-    } else if (name == "lens_scale") {
-      focal = false;
-    } else if (name == "principal_point") {
-      principal_point = false;
-    } else if (name == "distortion") {
-      distortion = false;
-    } else if (name == "m") {
-      m = false;
-    } else if (name == "tilt") {
-      tilt = false;
-    } else if (name == "decenter") {
-      decenter = false;
-    } else if (name == "shape") {
-      shape = false;
-    } else if (name == "poses") {
-      poses = false;
-    } else {
-      return "fixed: unknown block '" + name +
-             "' (lens, lens_scale, principal_point, distortion, m, tilt, decenter, shape, poses)";
+    bool known = name == "lens";
+    for (int k = 0; k < static_cast<int>(std::size(kSwitches)); ++k)
+      if (name == kSwitches[k].name || (name == "lens" && k < kLensSwitches)) {
+        this->*kSwitches[k].member = false;
+        known = true;
+      }
+    if (!known) {
+      std::string all = "lens";
+      for (const RefineSwitch& s : kSwitches) all += std::string(", ") + s.name;
+      return "fixed: unknown block '" + name + "' (" + all + ")";
     }
   }
   return {};
@@ -62,18 +60,10 @@ std::string RefineOptions::Hold(const std::set<std::string>& names) {
 
 std::set<std::string> RefineOptions::HeldNames() const {
   std::set<std::string> names;
-  if (!focal && !principal_point && !distortion) {
-    names.insert("lens");
-  } else {
-    if (!focal) names.insert("lens_scale");
-    if (!principal_point) names.insert("principal_point");
-    if (!distortion) names.insert("distortion");
-  }
-  if (!m) names.insert("m");
-  if (!tilt) names.insert("tilt");
-  if (!decenter) names.insert("decenter");
-  if (!shape) names.insert("shape");
-  if (!poses) names.insert("poses");
+  const bool whole_lens = !focal && !principal_point && !distortion;
+  if (whole_lens) names.insert("lens");
+  for (int k = whole_lens ? kLensSwitches : 0; k < static_cast<int>(std::size(kSwitches)); ++k)
+    if (!(this->*kSwitches[k].member)) names.insert(kSwitches[k].name);
   return names;
 }
 
