@@ -26,6 +26,7 @@ constexpr double kDeg = 180.0 / M_PI;
 constexpr double kToleranceConflict = 3.0;
 
 // Fewer views than this cannot separate the sensor from the poses (the CLI asks as many).
+// With the sensor held (held-out views, calib/cross_validation.h) one view is enough.
 constexpr size_t kMinViews = 3;
 
 // A view's corners fewer than this leave its pose (6 unknowns) barely determined.
@@ -378,7 +379,9 @@ class FitRun {
       }
     }
     const size_t fitted_views = std::count(result_.view_left_out.begin(), result_.view_left_out.end(), "");
-    if (fitted_views < kMinViews) {
+    const auto& r = options_.refine;
+    const bool sensor_free = r.focal || r.principal_point || r.distortion || r.m || r.tilt || r.decenter || r.shape;
+    if (fitted_views < (sensor_free ? kMinViews : 1)) {
       result_.solver_report = std::to_string(fitted_views) + " views are left after the outlier rule (" +
                               std::to_string(kMinViews) + " needed): the corners do not show one board through one sensor";
       return false;

@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "calib/board_scale.h"
+#include "calib/cross_validation.h"
 #include "calib/fit_covariance.h"
 #include "calib/image_file.h"
 #include "calib/rim_circle.h"
@@ -20,6 +21,9 @@ namespace {
 // Targets whose distances from the lens span less than this ratio count as "one
 // distance" (the warning above the fit's results).
 constexpr double kOneDistanceRatio = 1.5;
+
+// Where the two halves are compared when the user names no distance: a room's far wall.
+constexpr double kDefaultCrossValidationDistanceMm = 2000.0;
 
 // The detections without corners the target does not have and without corners marked
 // unrefined (the detector's own position, ~5x worse than refined ones: unweighted among
@@ -86,6 +90,35 @@ UsableViews ViewsForFit(const Sensor& start, const CalibrationInput& input, cons
   if (spread_deg < 1.0 && spread_mm < 5.0)
     throw InputError(InputMessage(input.source, "images", "all views show the target at one pose: move it between images"));
   return views;
+}
+
+// Moves the views named in `names` out of `views` (the held-out views).
+UsableViews SplitOff(UsableViews* views, const std::set<std::string>& names) {
+  UsableViews held;
+  held.detections = views->detections;
+  held.detections.images.clear();
+  UsableViews kept = held;
+  for (size_t v = 0; v < views->detections.images.size(); ++v) {
+    UsableViews& to = names.count(views->detections.images[v].image) ? held : kept;
+    to.detections.images.push_back(views->detections.images[v]);
+    to.poses.push_back(views->poses[v]);
+    to.observations += static_cast<int>(views->detections.images[v].corners.size());
+  }
+  *views = std::move(kept);
+  return held;
+}
+
+// The views `holdout` asks to keep out: spread evenly over the usable views, leaving >= 3.
+std::set<std::string> HoldoutNames(const CalibrationInput& input, const UsableViews& views, int holdout) {
+  std::set<std::string> names;
+  if (holdout <= 0) return names;
+  const size_t total = views.detections.images.size();
+  if (total < static_cast<size_t>(holdout) + 3)
+    throw InputError(InputMessage(input.source, "holdout",
+                                  std::to_string(holdout) + " views held out of " + std::to_string(total) +
+                                      " usable leave fewer than 3 for the fit"));
+  for (size_t v : EvenlySpreadIndices(total, static_cast<size_t>(holdout))) names.insert(views.detections.images[v].image);
+  return names;
 }
 
 // The rim circle of the images a detections file names (the median over those that read).
@@ -190,6 +223,9 @@ std::string CalibrationOptions::Check() const {
     if (!(n > 0.0 && std::isfinite(n))) return "distances_n: must be > 0 and finite";
   if (!(max_predicted_error_px >= 0.0 && std::isfinite(max_predicted_error_px))) return "max_predicted_error_px: must be >= 0";
   if (!(predicted_error_step_px > 0.0 && std::isfinite(predicted_error_step_px))) return "predicted_error_step_px: must be > 0";
+  if (holdout_views < 0) return "holdout_views: must be >= 0";
+  if (!(cross_validation_distance_mm >= 0.0 && std::isfinite(cross_validation_distance_mm)))
+    return "cross_validation_distance_mm: must be > 0 and finite (0: the default)";
   return "";
 }
 
@@ -238,6 +274,8 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
 
   int unrefined = 0;
   UsableViews views = ViewsForFit(guess, input, FittableCorners(input, detections, &unrefined), &warnings);
+  const std::set<std::string> holdout_names = HoldoutNames(input, views, options.holdout_views);
+  UsableViews held = SplitOff(&views, holdout_names);
   std::optional<Sensor> refit_start;  // the previous pass's fit, where the last fit started
   FitResult fit = FitSensor(guess, input.target, views.detections, views.poses, fit_options);
   // Second detection pass (aprilgrid from images): the corners are refined in patches
@@ -252,6 +290,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     DetectedImages found = FindCorners(input, options, refit_start, false);
     detections = std::move(found.detections);
     views = ViewsForFit(*refit_start, input, FittableCorners(input, detections, &unrefined), &warnings);
+    held = SplitOff(&views, holdout_names);
     fit = FitSensor(*refit_start, input.target, views.detections, views.poses, fit_options);
   }
   const Sensor& fit_start = refit_start ? *refit_start : guess;
@@ -290,6 +329,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   const std::string why_invalid = ValidateSensorModel(fit.sensor->model());
 
   record.rms_px = fit.rms_px;
+  record.rms_all_px = AllCornerRms(fit);
   record.converged = fit.converged;
   record.outliers = fit.outliers;
   record.dropped = fit.dropped;
@@ -357,10 +397,49 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   record.fitted_rim_radius_mm = fit.sensor->rim_radius_mm();
   if (fit.covariance_ok) record.covariance_names = fit.covariance_names, record.covariance = fit.covariance;
 
+  DetectionSet fitted_views = usable;  // the field the fit saw: its fitted views
+  fitted_views.images.clear();
+  std::vector<TargetPose> fitted_start_poses;  // their starting poses
+  for (size_t v = 0; v < usable.images.size(); ++v)
+    if (fit.view_left_out[v].empty())
+      fitted_views.images.push_back(usable.images[v]), fitted_start_poses.push_back(views.poses[v]);
+  const std::vector<Eigen::Vector2d> field =
+      FieldPixels(*fit.sensor, FieldOfCorners(*fit.sensor, fitted_views), options.predicted_error_step_px);
+  const double rim_mm = guess.rim_radius_mm();  // n counts the start's (design) rim radii
+
+  // Generalisation (calib/cross_validation.h): held-out views through the fitted sensor;
+  // two halves' calibrations compared where the user looks.
+  if (!holdout_names.empty()) {
+    ProgressReporter progress(options.progress, "holdout", 1);
+    record.holdout = EvaluateHeldOutViews(*fit.sensor, input.target, held.detections, fit_options);
+    progress.Step();
+    for (const auto& [image, why] : record.holdout->not_evaluated)
+      warnings.push_back({WarningCode::kViewLeftOut, image, image + ": held-out view not evaluated: " + why});
+    // 25 %: more than the few-percent spread of per-view RMS a well-posed fit shows between
+    // views of one set (the BabelCalib protocol's usual reading).
+    if (record.holdout->rms_px > 1.25 * record.rms_all_px) {
+      char text[300];
+      std::snprintf(text, sizeof text,
+                    "the %zu held-out views fit at %.3f px RMS against %.3f px for the training views: the model "
+                    "does not predict new views as well as it fits its own (too flexible, or too few views)",
+                    record.holdout->images.size(), record.holdout->rms_px, record.rms_all_px);
+      warnings.push_back({WarningCode::kHeldOutWorse, "", text});
+    }
+  }
+  if (options.cross_validate) {
+    double distance_mm = options.cross_validation_distance_mm;
+    if (!(distance_mm > 0.0)) distance_mm = !options.distances_mm.empty()   ? options.distances_mm.front()
+                                            : !options.distances_n.empty() ? options.distances_n.front() * rim_mm
+                                                                           : kDefaultCrossValidationDistanceMm;
+    ProgressReporter progress(options.progress, "cross-validation", 1);
+    TwoHalves halves = CrossValidateHalves(fit_start, input.target, fitted_views, fitted_start_poses, fit_options, field, distance_mm);
+    progress.Step();
+    record.cross_validation = CalibrationRecord::CrossValidationRecord{halves.images, halves.rms_px, std::move(halves.diff)};
+  }
+
   // The error at the user's distances: the covariance through the projection over the
   // observed field (calib/predicted_error.h). Default: the corners' median distance from
   // their reflection points, and infinity.
-  const double rim_mm = guess.rim_radius_mm();  // n counts the start's (design) rim radii
   if (fit.covariance_ok) {
     std::vector<double> distances = options.distances_mm;
     for (double n : options.distances_n) distances.push_back(n * rim_mm);
@@ -369,12 +448,6 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
         distances.push_back(median_mm);
       distances.push_back(kInfinityMm);
     }
-    DetectionSet fitted = usable;  // the field the fit saw: its fitted views
-    fitted.images.clear();
-    for (size_t v = 0; v < usable.images.size(); ++v)
-      if (fit.view_left_out[v].empty()) fitted.images.push_back(usable.images[v]);
-    const std::vector<Eigen::Vector2d> field =
-        FieldPixels(*fit.sensor, FieldOfCorners(*fit.sensor, fitted), options.predicted_error_step_px);
     predicted = PredictProjectionError(*fit.sensor, fit, field, distances);
     for (const PredictedError& map : predicted) {
       const bool infinite = map.distance_mm >= kInfinityMm;

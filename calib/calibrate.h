@@ -50,6 +50,13 @@ struct CalibrationOptions {
   int detection_passes = 2;
   int threads = 1;  // detection
   bool leave_one_out = false;
+  // Generalisation (calib/cross_validation.h): views kept out of the fit (spread evenly
+  // over the input) and evaluated with the sensor held; the usable views split in two
+  // halves, each calibrated, compared at cross_validation_distance_mm (0: the first of
+  // distances_mm / distances_n, else 2 m).
+  int holdout_views = 0;
+  bool cross_validate = false;
+  double cross_validation_distance_mm = 0.0;
   DesignTolerances tolerances;  // added to / overriding the guess's
   std::vector<double> distances_mm, distances_n;  // for the predicted error (n: design rim radii)
   double max_predicted_error_px = 0.3;

@@ -19,6 +19,14 @@ const char* const kPredictedErrorDefinition =
     "per pixel of the observed field: sqrt(trace(J C J^T)), the RMS length of the 2-D error vector of a point at "
     "that distance from its reflection point, C the fit's covariance (poses marginalised)";
 
+const char* const kHoldoutDefinition =
+    "views kept out of the fit (spread evenly over the input), their poses fitted with the sensor held; rms_px over "
+    "all their corners, per corner sqrt(mean |e|^2); compare with training_rms_px (the fitted views, all corners)";
+const char* const kCrossValidationDefinition =
+    "the usable views split into even and odd positions, each half calibrated alone; the points distance_mm along "
+    "each observed field pixel's ray through half 1 (from its reflection point), moved by the rigid motion that "
+    "best aligns them, projected through half 2; diff_*_px are lengths of the 2-D pixel differences";
+
 json NumberOrNull(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 double NumberOrNan(const json& value) { return value.is_null() ? NAN : value.get<double>(); }
 json DistanceOrInfinity(double value, bool infinite) { return infinite ? json("infinity") : json(value); }
@@ -26,9 +34,23 @@ double ReadDistance(const json& value, double infinity) {
   return value.is_string() && value.get<std::string>() == "infinity" ? infinity : value.get<double>();
 }
 
+// The summary of a projection difference (calibration.json's cross_validation, diff.json).
+json DiffSummary(const ProjectionDiff& d) {
+  return {{"distance_mm", DistanceOrInfinity(d.distance_mm, d.distance_mm >= kInfinityMm)},
+          {"diff_rms_px", NumberOrNull(d.rms_px)},
+          {"diff_median_px", NumberOrNull(d.median_px)},
+          {"diff_max_px", NumberOrNull(d.max_px)},
+          {"unaligned_rms_px", NumberOrNull(d.unaligned_rms_px)},
+          {"grid_points", d.compared},
+          {"aligned", d.aligned},
+          {"rotation_deg", d.rotation_deg},
+          {"translation_mm", {d.translation_mm.x(), d.translation_mm.y(), d.translation_mm.z()}}};
+}
+
 json ToJson(const CalibrationRecord& r) {
   json j;
   j["rms_px"] = r.rms_px;
+  j["rms_all_px"] = NumberOrNull(r.rms_all_px);
   j["converged"] = r.converged;
   j["outliers"] = r.outliers;
   j["dropped"] = r.dropped;
@@ -46,6 +68,26 @@ json ToJson(const CalibrationRecord& r) {
                        {"inlier_fraction", r.rim_circle->inlier_fraction},
                        {"rms_px", r.rim_circle->rms_px}};
   for (const auto& [name, s] : r.leave_one_out) j["leave_one_out"][name] = {{"min", s.min}, {"max", s.max}, {"std", s.std}};
+  if (const auto& h = r.holdout) {
+    json& out = j["holdout"];
+    out["views"] = h->images;
+    out["rms_px"] = NumberOrNull(h->rms_px);
+    out["inlier_rms_px"] = NumberOrNull(h->inlier_rms_px);
+    out["corners"] = h->corners;
+    out["outliers"] = h->outliers;
+    for (const auto& [image, rms] : h->per_view_rms_px) out["per_view_rms_px"][image] = NumberOrNull(rms);
+    for (const auto& [image, why] : h->not_evaluated) out["not_evaluated"][image] = why;
+    out["training_rms_px"] = NumberOrNull(r.rms_all_px);
+    out["training_inlier_rms_px"] = r.rms_px;
+    out["definition"] = kHoldoutDefinition;
+  }
+  if (const auto& c = r.cross_validation) {
+    json& out = j["cross_validation"];
+    out = DiffSummary(c->diff);
+    out["halves"] = c->halves;
+    out["half_rms_px"] = {NumberOrNull(c->half_rms_px[0]), NumberOrNull(c->half_rms_px[1])};
+    out["definition"] = kCrossValidationDefinition;
+  }
   j["target_distance_mm"] = {{"nearest", r.nearest_target_mm}, {"farthest", r.farthest_target_mm}};
   for (const auto& [image, why] : r.views_left_out) j["views_left_out"][image] = why;
   j["outlier_threshold_px"] = r.outlier_threshold_px;
@@ -124,6 +166,37 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
     if (j.contains("leave_one_out"))
       for (const auto& [parameter, s] : at("leave_one_out").items())
         r.leave_one_out[parameter] = {s.at("min").get<double>(), s.at("max").get<double>(), s.at("std").get<double>()};
+    if (j.contains("rms_all_px")) r.rms_all_px = NumberOrNan(at("rms_all_px"));
+    if (j.contains("holdout")) {
+      const json& h = at("holdout");
+      HeldOutViews held;
+      held.images = h.at("views").get<std::vector<std::string>>();
+      held.rms_px = NumberOrNan(h.at("rms_px"));
+      held.inlier_rms_px = NumberOrNan(h.at("inlier_rms_px"));
+      held.corners = h.at("corners").get<int>();
+      held.outliers = h.at("outliers").get<int>();
+      if (h.contains("per_view_rms_px"))
+        for (const auto& [image, rms] : h.at("per_view_rms_px").items()) held.per_view_rms_px[image] = NumberOrNan(rms);
+      if (h.contains("not_evaluated")) held.not_evaluated = h.at("not_evaluated").get<std::map<std::string, std::string>>();
+      r.holdout = held;
+    }
+    if (j.contains("cross_validation")) {
+      const json& c = at("cross_validation");
+      CalibrationRecord::CrossValidationRecord cross;
+      cross.halves = c.at("halves").get<std::array<std::vector<std::string>, 2>>();
+      cross.half_rms_px = {NumberOrNan(c.at("half_rms_px").at(0)), NumberOrNan(c.at("half_rms_px").at(1))};
+      cross.diff.distance_mm = ReadDistance(c.at("distance_mm"), kInfinityMm);
+      cross.diff.rms_px = NumberOrNan(c.at("diff_rms_px"));
+      cross.diff.median_px = NumberOrNan(c.at("diff_median_px"));
+      cross.diff.max_px = NumberOrNan(c.at("diff_max_px"));
+      cross.diff.unaligned_rms_px = NumberOrNan(c.at("unaligned_rms_px"));
+      cross.diff.compared = c.at("grid_points").get<int>();
+      cross.diff.aligned = c.at("aligned").get<bool>();
+      cross.diff.rotation_deg = c.at("rotation_deg").get<double>();
+      const json& t = c.at("translation_mm");
+      cross.diff.translation_mm = Eigen::Vector3d(t.at(0).get<double>(), t.at(1).get<double>(), t.at(2).get<double>());
+      r.cross_validation = cross;
+    }
     const json& distance = at("target_distance_mm");
     r.nearest_target_mm = distance.at("nearest").is_null() ? HUGE_VAL : distance.at("nearest").get<double>();
     r.farthest_target_mm = distance.at("farthest").get<double>();
@@ -189,5 +262,19 @@ CalibrationRecord ParseCalibrationJson(const std::string& text, const std::strin
 }
 
 CalibrationRecord ReadCalibrationJson(const std::string& path) { return FromJson(ReadJsonFile(path), path); }
+
+void WriteProjectionDiffJson(const ProjectionDiff& diff, const std::map<std::string, std::string>& labels,
+                             const std::string& path) {
+  json j = DiffSummary(diff);
+  for (const auto& [key, value] : labels) j[key] = value;
+  j["definition"] =
+      "the points distance_mm along each field pixel's ray through a (from its reflection point), moved by the rigid "
+      "motion that best aligns them, projected through b; differences are b's pixel minus the field pixel";
+  for (size_t k = 0; k < diff.pixels.size(); ++k)
+    j["pixels"].push_back({{"pixel", {diff.pixels[k].x(), diff.pixels[k].y()}},
+                           {"difference_px", {NumberOrNull(diff.difference_px[k].x()), NumberOrNull(diff.difference_px[k].y())}}});
+  const std::string text = j.dump(1) + "\n";
+  WriteFileAtomically(path, [&](std::ostream& out) { out << text; });
+}
 
 }  // namespace omnical

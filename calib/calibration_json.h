@@ -3,6 +3,7 @@
 // "infinity" (the predicted error's infinite distance).
 #pragma once
 
+#include <map>
 #include <string>
 
 #include "calib/calibration_record.h"
@@ -16,5 +17,11 @@ void WriteCalibrationJson(const CalibrationRecord& record, const std::string& pa
 // Throws InputError "path: field: problem".
 CalibrationRecord ReadCalibrationJson(const std::string& path);
 CalibrationRecord ParseCalibrationJson(const std::string& text, const std::string& name);
+
+// A projection difference (calib/projection_diff.h) as omnical diff writes it: the
+// summary, `labels` (e.g. "a", "b", "field": what was compared), and per field pixel the
+// pixel and its difference. Written atomically; throws InputError naming the path.
+void WriteProjectionDiffJson(const ProjectionDiff& diff, const std::map<std::string, std::string>& labels,
+                             const std::string& path);
 
 }  // namespace omnical

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include <cmath>
+#include <array>
 #include <map>
 #include <optional>
 #include <set>
@@ -13,12 +14,14 @@
 #include <vector>
 
 #include "calib/bundle_fit.h"
+#include "calib/cross_validation.h"
 #include "calib/design_tolerances.h"
 
 namespace omnical {
 
 struct CalibrationRecord {
   double rms_px = 0.0;  // per corner, sqrt(mean |e|^2), over the inliers
+  double rms_all_px = NAN;  // the same over every fitted corner, outliers included
   bool converged = false;
   int outliers = 0, dropped = 0, unrefined_corners_left_out = 0, observations = 0;
   std::string solver_report;
@@ -36,6 +39,17 @@ struct CalibrationRecord {
     double min = 0.0, max = 0.0, std = 0.0;
   };
   std::map<std::string, Spread> leave_one_out;  // per parameter; empty unless asked
+  // Views kept out of the fit and evaluated with the sensor held (CalibrationOptions::
+  // holdout_views); the training RMS to compare with is rms_all_px / rms_px.
+  std::optional<HeldOutViews> holdout;
+  // The two halves' calibrations compared (CalibrationOptions::cross_validate). The diff's
+  // per-pixel vectors are kept in memory for the report's figure; the file has the summary.
+  struct CrossValidationRecord {
+    std::array<std::vector<std::string>, 2> halves;
+    std::array<double, 2> half_rms_px{{NAN, NAN}};
+    ProjectionDiff diff;
+  };
+  std::optional<CrossValidationRecord> cross_validation;
   double nearest_target_mm = 0.0, farthest_target_mm = 0.0;  // fitted views, from the lens
   std::map<std::string, std::string> views_left_out;          // image -> why
   double outlier_threshold_px = 0.0;

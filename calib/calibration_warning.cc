@@ -20,6 +20,7 @@ const char* WarningCodeName(WarningCode code) {
     case WarningCode::kToleranceNote: return "tolerance_note";
     case WarningCode::kPredictedErrorUnknown: return "predicted_error_unknown";
     case WarningCode::kPredictedErrorHigh: return "predicted_error_high";
+    case WarningCode::kHeldOutWorse: return "held_out_worse";
   }
   return "unknown";
 }

@@ -23,6 +23,7 @@ enum class WarningCode {
   kToleranceNote,             // a tolerance the fit could not use
   kPredictedErrorUnknown,     // no field pixel projects at a distance
   kPredictedErrorHigh,        // the predicted projection error exceeds the threshold
+  kHeldOutWorse,              // held-out views fit much worse than the training views
 };
 
 // A stable lower-case name for programs (Python's CalibrationWarning.code), e.g.

@@ -28,7 +28,9 @@ const FlagTable kFlags = {{"fixed", "--fix"}, {"robust_loss_px", "--loss-px"}, {
                           {"max_iterations", "--max-iterations"}, {"tolerances", "--tolerance"}, {"profile", "--profile"},
                           {"rim_field_deg", "--rim-field-deg"}, {"guess", "--sensor"}, {"threads", "--threads"},
                           {"detection_passes", "--detection-passes"}, {"distances_mm", "--distance-mm"},
-                          {"distances_n", "--distance-n"}, {"max_predicted_error_px", "--max-predicted-error-px"}};
+                          {"distances_n", "--distance-n"}, {"max_predicted_error_px", "--max-predicted-error-px"},
+                          {"holdout_views", "--holdout"}, {"holdout", "--holdout"}, {"cross_validate", "--cross-validate"},
+                          {"cross_validation_distance_mm", "--cross-validate-distance-mm"}};
 
 void Run(Options options, const Context& context) {
   CalibrationInput input;
@@ -78,6 +80,15 @@ void Run(Options options, const Context& context) {
       std::printf("  %-16s %14.8g +- %.3g\n", p.name.c_str(), p.value, p.std);
     }
   }
+  std::printf("all fitted corners, outliers included: RMS %.4f px\n", result.record.rms_all_px);
+  if (const auto& held = result.record.holdout)
+    std::printf("held out: %zu views, %d corners: RMS %.4f px (training %.4f px, ratio %.2f)\n", held->images.size(),
+                held->corners, held->rms_px, result.record.rms_all_px, held->rms_px / result.record.rms_all_px);
+  if (const auto& cross = result.record.cross_validation)
+    std::printf("two halves (RMS %.4f / %.4f px) differ at %.0f mm by %.4f px RMS, %.4f px max over %d field pixels "
+                "(after the best rigid alignment: %.3f deg, %.2f mm)\n",
+                cross->half_rms_px[0], cross->half_rms_px[1], cross->diff.distance_mm, cross->diff.rms_px,
+                cross->diff.max_px, cross->diff.compared, cross->diff.rotation_deg, cross->diff.translation_mm.norm());
 }
 
 }  // namespace
@@ -126,6 +137,17 @@ Command CalibrateCommand() {
             sub.add_option("--max-predicted-error-px", library.max_predicted_error_px,
                            "Warn when the predicted projection error anywhere in the observed field exceeds this")
                 ->check(CLI::Range(0.0, 1000.0))->capture_default_str();
+            sub.add_option("--holdout", library.holdout_views,
+                           "Keep K views (spread evenly) out of the fit and report their RMS with the sensor held "
+                           "(their poses fitted): how well the calibration predicts new views")
+                ->check(CLI::Range(0, 10000));
+            sub.add_flag("--cross-validate", library.cross_validate,
+                         "Also calibrate each half of the views (even / odd) and report how far the two disagree over "
+                         "the observed field after the best rigid alignment (report/cross_validation.png)");
+            sub.add_option("--cross-validate-distance-mm", library.cross_validation_distance_mm,
+                           "Distance of the cross-validation comparison (mm from the reflection point; default: the "
+                           "first --distance-mm / --distance-n, else 2000)")
+                ->check(kPositive);
             sub.add_flag("--leave-one-out", library.leave_one_out,
                          "Also fit without each image in turn; calibration.json gets each parameter's spread");
             return [options, &context]() { Run(*options, context); };

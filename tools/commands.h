@@ -15,6 +15,7 @@ Command TargetCommand();
 Command RenderCommand();
 Command DetectCommand();
 Command CalibrateCommand();
+Command DiffCommand();
 Command RemapCommand();
 Command UnwarpCommand();
 Command ExportCentralCommand();
@@ -22,7 +23,7 @@ Command DesignCommand();
 
 inline std::vector<Command> AllCommands() {
   return {ProjectCommand(), UnprojectCommand(), CharacterizeCommand(), ParallaxCommand(), TargetCommand(),
-          RenderCommand(),  DetectCommand(),    CalibrateCommand(), RemapCommand(),    UnwarpCommand(),
+          RenderCommand(),  DetectCommand(),    CalibrateCommand(), DiffCommand(), RemapCommand(),    UnwarpCommand(),
           ExportCentralCommand(), DesignCommand()};
 }
 

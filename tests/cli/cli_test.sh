@@ -221,6 +221,38 @@ fi
 "$omnical" -q calibrate --target "$grid" --detections "$work/det.json" --sensor "$guess" --out "$work/cal_loo" --leave-one-out 2>/dev/null &&
   python3 -c "import json,sys; d=json.load(open(sys.argv[1])); l=d['leave_one_out']; sys.exit(0 if set(l) == set(d['parameters']) and l['fx_px']['max'] >= l['fx_px']['min'] else 1)" "$work/cal_loo/calibration.json" &&
   pass || fail "calibrate --leave-one-out"
+# Generalisation: 2 views held out and evaluated, two halves compared; then omnical diff
+# between two calibrations. On these 8 renders (detected corners, ~0.15 px) the held-out
+# views fit within 2x the training RMS (measured 0.04 vs 0.11 px, outliers included) and
+# the halves of 3 views each differ by 0.32 px RMS at 1 m (bound 1 px: a sanity bound, the
+# library tests check the numbers against known answers).
+if "$omnical" -q calibrate --target "$grid" --detections "$work/det.json" --sensor "$guess" --out "$work/cal_cv" \
+    --holdout 2 --cross-validate --cross-validate-distance-mm 1000 2>/dev/null; then
+  python3 - "$work/cal_cv/calibration.json" <<'PYCV' && pass || fail "calibrate --holdout --cross-validate"
+import json, sys
+d = json.load(open(sys.argv[1]))
+h, c = d["holdout"], d["cross_validation"]
+ok = len(h["views"]) == 2 and h["corners"] > 0 and 0 < h["rms_px"] < 2 * h["training_rms_px"]
+ok &= not any(v in d["per_view_rms_px"] for v in h["views"])  # kept out of the fit
+ok &= c["distance_mm"] == 1000 and c["grid_points"] > 100 and 0 <= c["diff_rms_px"] < 1.0
+ok &= sorted(c["halves"][0] + c["halves"][1]) == sorted(d["per_view_rms_px"])
+print(f"holdout {h['rms_px']:.3f} vs {h['training_rms_px']:.3f} px; halves differ {c['diff_rms_px']:.3f} px")
+sys.exit(0 if ok else 1)
+PYCV
+  [ -s "$work/cal_cv/report/cross_validation.png" ] && [ -s "$work/cal_cv/report/holdout.png" ] && pass ||
+    fail "calibrate --cross-validate figures"
+  # A calibration against itself differs by nothing; against the 6-view one, by little.
+  out=$("$omnical" diff "$work/cal" "$work/cal" --distance-mm 1000 --out "$work/diff_self") &&
+    python3 -c "import json,sys; d=json.load(open(sys.argv[1])); sys.exit(0 if d['diff_rms_px'] < 1e-9 and d['grid_points'] > 100 else 1)" \
+      "$work/diff_self/diff.json" && [ -s "$work/diff_self/diff.png" ] && pass || fail "diff of a calibration with itself: $out"
+  "$omnical" diff "$work/cal" "$work/cal_cv/sensor.yaml" --field "$work/det.json" --distance-mm 1000 --out "$work/diff_cv" |
+    grep -q "^at 1000 mm over" && python3 -c "import json,sys; d=json.load(open(sys.argv[1])); sys.exit(0 if 0 < d['diff_rms_px'] < 0.5 else 1)" \
+      "$work/diff_cv/diff.json" && pass || fail "diff of two calibrations"
+else
+  fail "calibrate --holdout --cross-validate exited $?"
+fi
+expect_error diff_missing_sensor "nowhere.yaml" -- diff "$work/cal" "$work/nowhere.yaml" --out "$work/out.csv"
+expect_error diff_other_camera "image_size: differs" -- diff "$work/cal" "$sensors/ohte-sph.yaml" --out "$work/out.csv"
 # Bad input: nothing may be written.
 python3 - "$work/det.json" "$work" <<'PYBAD'
 import json, sys
@@ -238,6 +270,10 @@ calibrate_error() {
   [ ! -e "$work/cal_bad" ] && pass || fail "$name: left $work/cal_bad behind"
 }
 calibrate_error calibrate_too_few_views "too few" --target "$grid" --detections "$work/det_two.json"
+calibrate_error calibrate_holdout_too_many "holdout: 6 views held out of 8 usable leave fewer than 3 for the fit" \
+  --target "$grid" --detections "$work/det.json" --holdout 6
+calibrate_error calibrate_halves_too_small "--cross-validate: half 2 has 2 views (need >= 3 per half" \
+  --target "$grid" --detections "$work/det.json" --holdout 3 --cross-validate
 calibrate_error calibrate_one_pose "all views show the target at one pose" --target "$grid" --detections "$work/det_same.json"
 calibrate_error calibrate_spec_matches_nothing "matches no corner id" --target "$work/other_ids.yaml" --detections "$work/det.json"
 calibrate_error calibrate_image_size "image_size: 1000 x 1000 differs from the sensor's 1040 x 1040" --target "$grid" --detections "$work/det_size.json"

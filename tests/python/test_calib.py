@@ -279,6 +279,50 @@ def test_calibrate_from_detections_without_guess_with_leave_one_out(runs, tmp_pa
         assert spread["min"] <= spread["max"] and spread["std"] >= 0
 
 
+def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
+    """Held-out views, the two halves and omnical.diff: both front ends, the same numbers."""
+    detections = runs.out / "cli" / "detections.json"
+    result, done = beside_cli(
+        ["-q", "calibrate", "--target", TARGET, "--detections", detections, "--sensor", GUESS, "--holdout", 2,
+         "--cross-validate", "--cross-validate-distance-mm", 1500, "--out", tmp_path / "cli"],
+        lambda: omnical.calibrate(TARGET, detections=detections, guess=GUESS, holdout=2, cross_validate=True,
+                                  cross_validation_distance_mm=1500))
+    assert done.returncode == 0, done.stderr
+    cli = json.loads((tmp_path / "cli" / "calibration.json").read_text())
+    assert_json_equal(json.loads(result.to_json()), cli)
+    held, cross = result.holdout, result.cross_validation
+    assert held["views"] == cli["holdout"]["views"] and len(held["views"]) == 2
+    assert close(held["rms_px"], cli["holdout"]["rms_px"]) and held["corners"] == cli["holdout"]["corners"] > 0
+    assert close(held["training_rms_px"], result.rms_all_px)
+    assert [list(h) for h in cross["halves"]] == cli["cross_validation"]["halves"]
+    assert close(cross["rms_px"], cli["cross_validation"]["diff_rms_px"]) and cross["distance_mm"] == 1500
+    assert omnical.load_calibration(tmp_path / "cli" / "calibration.json").holdout["views"] == held["views"]
+
+    # diff: the full calibration against the held-out one, over the detections' annulus.
+    done = run_cli("-q", "diff", runs.out / "cli", tmp_path / "cli", "--field", detections, "--distance-mm", 1500,
+                   "--out", tmp_path / "diff")
+    assert done.returncode == 0, done.stderr
+    cli_diff = json.loads((tmp_path / "diff" / "diff.json").read_text())
+    mine = omnical.diff(runs.out / "cli", tmp_path / "cli" / "sensor.yaml", distance_mm=1500, field=detections)
+    for key in ("rms_px", "median_px", "max_px", "unaligned_rms_px"):
+        assert close(mine[key], cli_diff["diff_" + key if key != "unaligned_rms_px" else key]), key
+    assert mine["compared"] == cli_diff["grid_points"] == len(cli_diff["pixels"])
+    assert mine["pixels"].shape == mine["difference_px"].shape == (len(cli_diff["pixels"]), 2)
+    same = omnical.diff(result.sensor, result.sensor, distance_mm=1500)
+    assert same["rms_px"] < 1e-7 and same["compared"] > 100
+
+    # Bad values: the CLI's message with the kwarg's name.
+    few_views = cli_error(run_cli("calibrate", "--target", TARGET, "--detections", detections, "--sensor", GUESS,
+                                  "--holdout", 40, "--out", tmp_path / "bad"))
+    with pytest.raises(omnical.InputError) as raised:
+        omnical.calibrate(TARGET, detections=detections, guess=GUESS, holdout=40)
+    assert str(raised.value) == few_views and "holdout: 40 views held out" in few_views
+    with pytest.raises(omnical.InputError, match="distance_mm: must be > 0"):
+        omnical.diff(result.sensor, result.sensor, distance_mm=0)
+    with pytest.raises(omnical.InputError, match="field: expected"):
+        omnical.diff(result.sensor, result.sensor, field=3)
+
+
 # --- detect ------------------------------------------------------------------------------
 
 def test_detect_equals_cli_and_arrays_equal_paths(few, tmp_path):

@@ -24,6 +24,7 @@
 #include "calib/calibration_json.h"
 #include "calib/fit_covariance.h"
 #include "calib/image_file.h"
+#include "calib/projection_diff.h"
 #include "calib/report/calibration_report.h"
 #include "model/input_error.h"
 #include "model/io/atomic_write.h"
@@ -155,6 +156,14 @@ py::dict PoseMatrices(const std::map<std::string, TargetPose>& poses) {
   return out;
 }
 
+// A projection difference's summary (as calibration.json's cross_validation and diff.json).
+py::dict DiffDict(const ProjectionDiff& d) {
+  return py::dict("distance_mm"_a = d.distance_mm >= kInfinityMm ? HUGE_VAL : d.distance_mm, "rms_px"_a = d.rms_px,
+                  "median_px"_a = d.median_px, "max_px"_a = d.max_px, "unaligned_rms_px"_a = d.unaligned_rms_px,
+                  "compared"_a = d.compared, "aligned"_a = d.aligned, "rotation_deg"_a = d.rotation_deg,
+                  "translation_mm"_a = py::make_tuple(d.translation_mm.x(), d.translation_mm.y(), d.translation_mm.z()));
+}
+
 // The record's fields, shared by CalibrationRecord and CalibrationResult (which reads
 // them from its record), so a result and a calibration.json read back look alike.
 template <typename Holder, typename Get>
@@ -163,6 +172,8 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
     cls.def_property_readonly(name, [record, member](const Holder& holder) { return record(holder).*member; }, doc);
   };
   field("rms_px", &CalibrationRecord::rms_px, "Reprojection RMS per corner over the inliers (px).");
+  field("rms_all_px", &CalibrationRecord::rms_all_px,
+        "Reprojection RMS per corner over every fitted corner, outliers included (px).");
   field("converged", &CalibrationRecord::converged, "Whether the solver converged.");
   field("observations", &CalibrationRecord::observations, "Corners in the fit.");
   field("outliers", &CalibrationRecord::outliers, "Corners removed as gross outliers.");
@@ -223,6 +234,30 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
         return out;
       },
       "dict parameter -> {'min', 'max', 'std'} over the fits without each view (empty unless leave_one_out=True).");
+  cls.def_property_readonly(
+      "holdout",
+      [record](const Holder& holder) -> py::object {
+        const CalibrationRecord& r = record(holder);
+        if (!r.holdout) return py::none();
+        const HeldOutViews& h = *r.holdout;
+        return py::dict("views"_a = h.images, "rms_px"_a = h.rms_px, "inlier_rms_px"_a = h.inlier_rms_px,
+                        "corners"_a = h.corners, "outliers"_a = h.outliers, "per_view_rms_px"_a = h.per_view_rms_px,
+                        "not_evaluated"_a = h.not_evaluated, "training_rms_px"_a = r.rms_all_px);
+      },
+      "The held-out views (holdout=K): dict views, rms_px (all their corners, sensor held, poses fitted), "
+      "inlier_rms_px, corners, outliers, per_view_rms_px, not_evaluated, training_rms_px; None unless asked.");
+  cls.def_property_readonly(
+      "cross_validation",
+      [record](const Holder& holder) -> py::object {
+        const auto& c = record(holder).cross_validation;
+        if (!c) return py::none();
+        py::dict out = DiffDict(c->diff);
+        out["halves"] = py::make_tuple(c->halves[0], c->halves[1]);
+        out["half_rms_px"] = py::make_tuple(c->half_rms_px[0], c->half_rms_px[1]);
+        return out;
+      },
+      "The two halves' comparison (cross_validate=True): dict halves, half_rms_px, distance_mm, rms_px, median_px, "
+      "max_px, unaligned_rms_px, compared, aligned, rotation_deg, translation_mm; None unless asked.");
   cls.def_property_readonly(
       "predicted_error",
       [record](const Holder& holder) {
@@ -298,7 +333,7 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
                         int max_iterations, int detection_passes, int threads, bool leave_one_out,
                         const py::object& tolerances, const std::vector<double>& distances_mm,
                         const std::vector<double>& distances_n, double max_predicted_error_px, double rim_field_deg,
-                        py::object progress) {
+                        int holdout, bool cross_validate, double cross_validation_distance_mm, py::object progress) {
   CalibrationInput input;
   PyTarget target = TargetOf(target_arg);
   input.target = std::move(target.board);
@@ -335,6 +370,9 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
   options.distances_n = distances_n;
   options.max_predicted_error_px = max_predicted_error_px;
   options.rim_field_deg = rim_field_deg;
+  options.holdout_views = holdout;
+  options.cross_validate = cross_validate;
+  options.cross_validation_distance_mm = cross_validation_distance_mm;
   options.progress = ForwardProgress(std::move(progress));
   PyCalibration out{RunReleased([&] { return omnical::Calibrate(input, options); }), !input.detections, options,
                     std::move(input.images)};
@@ -459,7 +497,7 @@ void BindDetections(py::module_& m) {
           "code", [](const CalibrationWarning& w) { return WarningCodeName(w.code); },
           "What kind: image_unreadable, image_size_differs, checkerboard_refused, view_skipped, tolerance_not_applicable, "
           "view_left_out, sensor_invalid, not_converged, free_gauge, weakly_determined, one_distance, tolerance_conflict, "
-          "tolerance_note, predicted_error_unknown, predicted_error_high.")
+          "tolerance_note, predicted_error_unknown, predicted_error_high, held_out_worse.")
       .def_readonly("subject", &CalibrationWarning::subject, "The image or parameter it concerns ('' for the whole run).")
       .def_readonly("text", &CalibrationWarning::text, "The one-line message (what the CLI prints).")
       .def("__repr__", [](const CalibrationWarning& w) { return "<omnical.CalibrationWarning " + std::string(WarningCodeName(w.code)) + ": " + w.text + ">"; });
@@ -603,7 +641,8 @@ are also attributes here), the warnings with their codes, the views and residual
         "guess"_a = py::none(), "profile"_a = "", "fixed"_a = py::tuple(), "loss_px"_a = 1.0, "max_iterations"_a = 200,
         "detection_passes"_a = 2, "threads"_a = 0, "leave_one_out"_a = false, "tolerances"_a = py::none(),
         "distances_mm"_a = std::vector<double>(), "distances_n"_a = std::vector<double>(),
-        "max_predicted_error_px"_a = 0.3, "rim_field_deg"_a = kDefaultRimFieldDeg, "progress"_a = py::none(),
+        "max_predicted_error_px"_a = 0.3, "rim_field_deg"_a = kDefaultRimFieldDeg, "holdout"_a = 0,
+        "cross_validate"_a = false, "cross_validation_distance_mm"_a = 0.0, "progress"_a = py::none(),
         R"(Calibrates the sensor (as `omnical calibrate`) -> CalibrationResult.
 
 target: a Target or a spec path. Corners: images (as detect(): a directory or glob, a
@@ -617,8 +656,56 @@ loss_px: Huber scale (0: least squares). detection_passes: 2 re-detects through 
 first fit. threads: detection threads, 0 for all cores. leave_one_out: also fit without
 each view. tolerances: design tolerances (dict name -> one std, or 'name=value,...').
 distances_mm / distances_n: where to predict the projection error (mm, or rim radii);
-max_predicted_error_px: warn above it. progress(stage, done, total): False cancels.
+max_predicted_error_px: warn above it. holdout: K views (spread evenly) kept out of the
+fit and evaluated with the sensor held (result.holdout). cross_validate: each half of the
+views calibrated and compared at cross_validation_distance_mm (0: the first distance
+asked, else 2000) after the best rigid alignment (result.cross_validation).
+progress(stage, done, total): False cancels.
 Raises InputError with the library's message (too few views, a bad file, a bad value).)");
+
+  m.def(
+      "diff",
+      [](const py::object& a, const py::object& b, double distance_mm, const py::object& field, double step_px,
+         bool align) {
+        // A Sensor, a sensor file, or calibrate's output directory (its sensor.yaml).
+        const auto sensor_of = [](const py::object& given, const char* name) {
+          if (py::isinstance<Sensor>(given)) return given.cast<Sensor>();
+          if (!IsPath(given))
+            throw InputError(std::string(name) + ": expected an omnical.Sensor, a sensor file or a calibration directory, got " +
+                             TypeName(given));
+          std::string path = PathOf(given);
+          if (std::filesystem::is_directory(path)) path = (std::filesystem::path(path) / "sensor.yaml").string();
+          return LoadSensorYaml(path);
+        };
+        const Sensor reference = sensor_of(a, "a"), other = sensor_of(b, "b");
+        std::optional<DetectionSet> detections;
+        if (py::isinstance<PyDetections>(field)) {
+          detections = field.cast<const PyDetections&>().set;
+        } else if (IsPath(field)) {
+          detections = ReadDetections(PathOf(field));
+        } else if (!field.is_none()) {
+          throw InputError("field: expected an omnical.Detections, a detections file or None, got " + TypeName(field));
+        }
+        const ProjectionDiff diff = RunReleased([&] {
+          return CompareProjections(reference, other, ComparisonField(reference, detections ? &*detections : nullptr, step_px),
+                                    distance_mm, align);
+        });
+        py::dict out = DiffDict(diff);
+        out["pixels"] = PointsArray(diff.pixels);
+        out["difference_px"] = PointsArray(diff.difference_px);
+        return out;
+      },
+      "a"_a, "b"_a, py::kw_only(), "distance_mm"_a = 2000.0, "field"_a = py::none(), "step_px"_a = 16.0,
+      "align"_a = true,
+      R"(Compares two calibrations of one camera (as `omnical diff`) -> dict.
+
+a, b: a Sensor, a sensor file or calibrate's output directory. The points distance_mm
+along each field pixel's ray through a (from its reflection point; a large value such as
+1e8 for infinity), moved by the rigid motion that best aligns them (align=False: none),
+projected through b. field: Detections or a detections file whose corners' annulus is
+compared, None for every pixel of a's mirror; step_px apart. Returns rms_px, median_px,
+max_px, unaligned_rms_px, compared, aligned, rotation_deg, translation_mm, distance_mm,
+pixels (N, 2) and difference_px (N, 2; NaN where either does not project).)");
 }
 
 }  // namespace

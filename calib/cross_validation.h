@@ -1,0 +1,63 @@
+// How well a calibration generalises beyond the corners it was fitted to, measured the two
+// ways users of this field trust:
+// - held-out views (the BabelCalib protocol): views kept out of the fit, their poses fitted
+//   with the sensor held; their RMS against the training RMS says whether the model
+//   predicts new data or memorised the old (an over-flexible model fits its own corners
+//   and misses the next board's).
+// - two halves: the views split in two, each half calibrated on its own, and the two
+//   sensors compared over the observed field at a distance after the best rigid alignment
+//   (calib/projection_diff.h): how far two equally good calibrations disagree where the
+//   user will look.
+// RMS everywhere is per corner, sqrt(mean |e|^2) over 2-D residual vectors.
+#pragma once
+
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "calib/bundle_fit.h"
+#include "calib/detections.h"
+#include "calib/projection_diff.h"
+#include "calib/target.h"
+#include "model/sensor.h"
+
+namespace omnical {
+
+// `count` indices spread evenly over [0, total): the centres of `count` equal runs, so
+// held-out views sample the whole sequence (a hand-held set drifts in distance and angle).
+std::vector<size_t> EvenlySpreadIndices(size_t total, size_t count);
+
+// Per-corner RMS over every fitted view's corners with a residual, outliers included.
+double AllCornerRms(const FitResult& fit);
+
+struct HeldOutViews {
+  std::vector<std::string> images;               // held out, in the input's order
+  std::map<std::string, double> per_view_rms_px;  // all corners of the view (NaN: no pose)
+  std::map<std::string, std::string> not_evaluated;  // image -> why (no pose through the sensor)
+  double rms_px = NAN;         // all held-out corners
+  double inlier_rms_px = NAN;  // the corners the outlier rule keeps
+  int corners = 0, outliers = 0;
+};
+
+// The views' poses fitted with `sensor` held (robust loss and outlier rule as in
+// `options`; every view kept however it fits: a held-out view is a measurement, not a
+// suspect).
+HeldOutViews EvaluateHeldOutViews(const Sensor& sensor, const CalibrationTarget& target, const DetectionSet& views,
+                                  FitOptions options);
+
+struct TwoHalves {
+  std::array<std::vector<std::string>, 2> images;  // even and odd positions of the fitted views
+  std::array<double, 2> rms_px{{NAN, NAN}};       // each half's own fit, inliers
+  std::vector<Sensor> sensors;  // the two halves' fits, in that order
+  ProjectionDiff diff;  // sensors[1] against sensors[0]
+};
+
+// Each half fitted from `start` (the full fit's start, same options, no covariance), then
+// compared over `field_pixels` at distance_mm. Throws InputError when a half has fewer than
+// 3 views or its fit fails.
+TwoHalves CrossValidateHalves(const Sensor& start, const CalibrationTarget& target, const DetectionSet& views,
+                              const std::vector<TargetPose>& initial_poses, FitOptions options,
+                              const std::vector<Eigen::Vector2d>& field_pixels, double distance_mm);
+
+}  // namespace omnical

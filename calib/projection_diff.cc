@@ -1,0 +1,167 @@
+#include "calib/projection_diff.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "calib/predicted_error.h"
+#include "model/input_error.h"
+
+namespace omnical {
+namespace {
+
+// Pixels of `points` moved by (angle-axis, translation), through `sensor`; false if any
+// does not project (a step that pushes a field point off the mirror is not taken).
+bool MovedPixels(const Sensor& sensor, const Eigen::Matrix3Xd& points, const double* angle_axis, const double* translation,
+                 Eigen::Matrix2Xd* pixels) {
+  Eigen::Matrix3d rotation;
+  ceres::AngleAxisToRotationMatrix(angle_axis, ceres::ColumnMajorAdapter3x3(rotation.data()));
+  const Eigen::Matrix3Xd moved = (rotation * points).colwise() + Eigen::Vector3d(translation[0], translation[1], translation[2]);
+  std::vector<ProjectionStatus> statuses;
+  sensor.ProjectBatch(moved, pixels, &statuses);
+  return std::all_of(statuses.begin(), statuses.end(), [](ProjectionStatus s) { return s == ProjectionStatus::kOk; });
+}
+
+// All field points at once: one batch projection per evaluation, the 2N x 6 Jacobian by
+// central differences (the batch path has no Jets; six parameters make that cheap).
+class AlignmentCost : public ceres::CostFunction {
+ public:
+  AlignmentCost(const Sensor& other, Eigen::Matrix3Xd points, Eigen::Matrix2Xd targets_px)
+      : other_(other), points_(std::move(points)), targets_px_(std::move(targets_px)) {
+    set_num_residuals(static_cast<int>(2 * points_.cols()));
+    mutable_parameter_block_sizes()->push_back(3);
+    mutable_parameter_block_sizes()->push_back(3);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    Eigen::Matrix2Xd pixels;
+    if (!MovedPixels(other_, points_, parameters[0], parameters[1], &pixels)) return false;
+    Eigen::Map<Eigen::Matrix2Xd>(residuals, 2, points_.cols()) = pixels - targets_px_;
+    if (!jacobians) return true;
+    // Steps: 1e-6 rad and 1e-4 mm move a pixel by ~1e-3 px, far above the solvers'
+    // 1e-10 px and small enough to stay linear.
+    constexpr double kStep[2] = {1e-6, 1e-4};
+    for (int block = 0; block < 2; ++block) {
+      if (!jacobians[block]) continue;
+      for (int k = 0; k < 3; ++k) {
+        double plus[2][3], minus[2][3];
+        for (int b = 0; b < 2; ++b)
+          for (int i = 0; i < 3; ++i) plus[b][i] = minus[b][i] = parameters[b][i];
+        plus[block][k] += kStep[block];
+        minus[block][k] -= kStep[block];
+        Eigen::Matrix2Xd up, down;
+        if (!MovedPixels(other_, points_, plus[0], plus[1], &up) || !MovedPixels(other_, points_, minus[0], minus[1], &down))
+          return false;
+        const Eigen::Matrix2Xd column = (up - down) / (2.0 * kStep[block]);
+        for (Eigen::Index p = 0; p < points_.cols(); ++p) {
+          jacobians[block][(2 * p) * 3 + k] = column(0, p);
+          jacobians[block][(2 * p + 1) * 3 + k] = column(1, p);
+        }
+      }
+    }
+    return true;
+  }
+
+ private:
+  const Sensor& other_;
+  Eigen::Matrix3Xd points_;
+  Eigen::Matrix2Xd targets_px_;
+};
+
+}  // namespace
+
+std::vector<Eigen::Vector2d> ComparisonField(const Sensor& reference, const DetectionSet* detections, double step_px) {
+  if (!(step_px > 0.0 && std::isfinite(step_px))) throw InputError("step_px: must be > 0");
+  bool any_corner = false;
+  if (detections)
+    for (const ImageDetections& image : detections->images) any_corner |= !image.corners.empty();
+  ObservedField field;
+  if (any_corner) {
+    field = FieldOfCorners(reference, *detections);
+  } else {
+    field = FieldOfCorners(reference, DetectionSet());  // the centre; radii set below
+    field.inner_radius_px = 0.0;
+    field.outer_radius_px = HUGE_VAL;
+  }
+  return FieldPixels(reference, field, step_px);
+}
+
+ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, const std::vector<Eigen::Vector2d>& pixels,
+                                  double distance_mm, bool align) {
+  if (!(distance_mm > 0.0)) throw InputError("distance_mm: must be > 0");
+  ProjectionDiff diff;
+  diff.distance_mm = distance_mm;
+  diff.pixels = pixels;
+  diff.difference_px.assign(pixels.size(), Eigen::Vector2d::Constant(NAN));
+  // The reference's points, and which of them both sensors project.
+  std::vector<size_t> kept;
+  Eigen::Matrix3Xd points(3, pixels.size());
+  {
+    Eigen::Matrix2Xd grid(2, pixels.size());
+    for (size_t k = 0; k < pixels.size(); ++k) grid.col(k) = pixels[k];
+    Eigen::Matrix3Xd origins, directions;
+    std::vector<ProjectionStatus> unprojected;
+    reference.UnprojectBatch(grid, &origins, &directions, &unprojected);
+    points = origins + distance_mm * directions;
+    Eigen::Matrix2Xd through_other;
+    std::vector<ProjectionStatus> projected;
+    other.ProjectBatch(points, &through_other, &projected);
+    for (size_t k = 0; k < pixels.size(); ++k)
+      if (unprojected[k] == ProjectionStatus::kOk && projected[k] == ProjectionStatus::kOk && points.col(k).allFinite())
+        kept.push_back(k);
+  }
+  if (kept.size() < 6)
+    throw InputError("field: only " + std::to_string(kept.size()) +
+                     " field pixels project through both calibrations (need >= 6): are they of the same camera?");
+  Eigen::Matrix3Xd kept_points(3, kept.size());
+  Eigen::Matrix2Xd kept_pixels(2, kept.size());
+  for (size_t i = 0; i < kept.size(); ++i) kept_points.col(i) = points.col(kept[i]), kept_pixels.col(i) = pixels[kept[i]];
+
+  double angle_axis[3] = {0.0, 0.0, 0.0}, translation[3] = {0.0, 0.0, 0.0};
+  Eigen::Matrix2Xd before;
+  MovedPixels(other, kept_points, angle_axis, translation, &before);
+  diff.unaligned_rms_px = std::sqrt((before - kept_pixels).colwise().squaredNorm().mean());
+  if (align) {
+    ceres::Problem problem;
+    problem.AddResidualBlock(new AlignmentCost(other, kept_points, kept_pixels), nullptr, angle_axis, translation);
+    // At infinity a translation moves no point: only the rotation is determined.
+    if (distance_mm >= kInfinityMm) problem.SetParameterBlockConstant(translation);
+    ceres::Solver::Options options;
+    options.linear_solver_type = ceres::DENSE_QR;
+    options.max_num_iterations = 100;
+    options.function_tolerance = 1e-14;
+    options.parameter_tolerance = 1e-14;
+    options.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(options, &problem, &summary);
+    diff.aligned = summary.IsSolutionUsable();
+    if (!diff.aligned) angle_axis[0] = angle_axis[1] = angle_axis[2] = translation[0] = translation[1] = translation[2] = 0.0;
+  }
+  Eigen::Matrix2Xd after;
+  if (!MovedPixels(other, kept_points, angle_axis, translation, &after)) {
+    // Unreachable in practice (the solver only accepts steps where every point projects).
+    after = before;
+    diff.aligned = false;
+  }
+  const Eigen::Vector3d rotation_vector(angle_axis[0], angle_axis[1], angle_axis[2]);
+  diff.rotation_deg = rotation_vector.norm() * 180.0 / M_PI;
+  diff.rotation = rotation_vector.norm() > 0.0 ? Eigen::Quaterniond(Eigen::AngleAxisd(rotation_vector.norm(), rotation_vector.normalized()))
+                                               : Eigen::Quaterniond::Identity();
+  diff.translation_mm = Eigen::Vector3d(translation[0], translation[1], translation[2]);
+  std::vector<double> lengths;
+  double square = 0.0;
+  for (size_t i = 0; i < kept.size(); ++i) {
+    const Eigen::Vector2d d = after.col(i) - kept_pixels.col(i);
+    diff.difference_px[kept[i]] = d;
+    lengths.push_back(d.norm());
+    square += d.squaredNorm();
+  }
+  diff.compared = static_cast<int>(kept.size());
+  diff.rms_px = std::sqrt(square / kept.size());
+  MedianAndMax(lengths, &diff.median_px, &diff.max_px);
+  return diff;
+}
+
+}  // namespace omnical

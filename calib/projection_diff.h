@@ -1,0 +1,50 @@
+// How differently two calibrations of one sensor place the same objects: the points at a
+// distance along each field pixel's ray through the reference, moved by the rigid motion
+// that best maps them into the other calibration's frame, projected through the other.
+//
+// Two calibrations of one camera each choose their own frame (the poses absorb any rigid
+// motion of it), so the raw difference of their projections counts that choice as error.
+// The best rigid alignment (least squares in pixels over the field; rotation only at
+// infinity, where a translation moves nothing) removes it: what is left is what one
+// calibration gets wrong relative to the other. This is the "projection difference" of
+// mrcal's projection_diff, for non-central sensors: the points lie distance_mm along the
+// ray from its reflection point (calib/predicted_error.h's convention; kInfinityMm for
+// infinity). Lengths are per point: |difference| of the 2-D pixel vector, the same
+// per-corner convention as omnical's RMS.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "calib/detections.h"
+#include "model/sensor.h"
+
+namespace omnical {
+
+struct ProjectionDiff {
+  double distance_mm = 0.0;
+  std::vector<Eigen::Vector2d> pixels;         // the field pixels compared (reference image)
+  std::vector<Eigen::Vector2d> difference_px;  // other (aligned) - pixel; NaN where either does not project
+  double rms_px = NAN, median_px = NAN, max_px = NAN;  // over the compared pixels
+  int compared = 0;                             // pixels both sensors project
+  // The alignment: other_frame = rotation * reference_frame + translation_mm.
+  bool aligned = false;
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d translation_mm = Eigen::Vector3d::Zero();
+  double rotation_deg = 0.0;
+  double unaligned_rms_px = NAN;  // the same pixels before the alignment
+};
+
+// Throws InputError when fewer than 6 field pixels project through both sensors (nothing
+// to compare or to align on) or the distance is not > 0.
+ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, const std::vector<Eigen::Vector2d>& pixels,
+                                  double distance_mm, bool align = true);
+
+// The pixels to compare on, step_px apart: the annulus the detections' corners cover
+// (calib/predicted_error.h's FieldOfCorners) or, without detections (null or empty),
+// every pixel the reference sees through its mirror.
+std::vector<Eigen::Vector2d> ComparisonField(const Sensor& reference, const DetectionSet* detections, double step_px);
+
+}  // namespace omnical
