@@ -93,6 +93,8 @@ class FitRun {
          const std::vector<TargetPose>& initial_poses, const FitOptions& options)
       : guess_(guess), detections_(detections), options_(options), blocks_(guess), views_(detections.images.size()),
         problem_(ProblemOptions()), progress_(options.progress, "fit", 0), iteration_progress_(&progress_) {
+    with_warp_ = options.fit_board_warp || !options.board_warp.IsZero();
+    warp_mm_ = {options.board_warp.x_mm, options.board_warp.y_mm};
     result_.guess_rim_radius_mm = guess.rim_radius_mm;
     rotations_.resize(views_);
     translations_.resize(views_);
@@ -102,6 +104,7 @@ class FitRun {
       for (int k = 0; k < 3; ++k) translations_[v][k] = initial_poses[v].camera_from_target_translation_mm[k];
     }
     for (const TargetCorner& c : target.corners()) corner_points_[c.id] = c.point_in_target;
+    if (with_warp_) warp_basis_ = BoardWarp::Basis(target);
     // Robust mode: a redescending Cauchy loss while far from the solution (gross outliers
     // get almost no weight, where Huber's linear influence would still pull), then the
     // outliers are removed and the last solve uses Huber. The wrapper swaps every loss.
@@ -161,17 +164,20 @@ class FitRun {
           ++result_.dropped;  // an id the target does not have
           continue;
         }
-        auto functor = std::make_unique<Cost>(guess_, point->second, image.corners[i].pixel);
+        std::optional<Eigen::Vector2d> basis;
+        if (with_warp_) basis = warp_basis_.at(image.corners[i].id);
+        auto functor = std::make_unique<Cost>(guess_, point->second, image.corners[i].pixel, basis);
         std::vector<double*> blocks = blocks_.Pointers();
         blocks.push_back(rotations_[v].data());
         blocks.push_back(translations_[v].data());
+        if (with_warp_) blocks.push_back(warp_mm_.data());
         double check[2];
         if (!(*functor)(blocks.data(), check)) {
           ++result_.dropped;  // not projectable at the initial guess
           continue;
         }
         const ceres::ResidualBlockId id =
-            problem_.AddResidualBlock(Cost::Create(guess_, point->second, image.corners[i].pixel), loss_.get(), blocks);
+            problem_.AddResidualBlock(Cost::Create(guess_, point->second, image.corners[i].pixel, basis), loss_.get(), blocks);
         residuals_.push_back({v, i, std::move(functor), blocks, id});
         ++view_residuals_[v];
       }
@@ -277,6 +283,7 @@ class FitRun {
     toggle(blocks_.tilt_rad, options_.refine.tilt);
     toggle(blocks_.decenter_mm, options_.refine.decenter);
     if (!blocks_.shape.empty()) toggle(blocks_.shape.data(), options_.refine.shape);
+    if (with_warp_ && problem_.HasParameterBlock(warp_mm_.data())) toggle(warp_mm_.data(), options_.fit_board_warp);
   }
   void SetPoses(bool variable) {
     for (size_t v = 0; v < views_; ++v) {
@@ -431,6 +438,7 @@ class FitRun {
     Eigen::MatrixXd covariance;
     if (options_.compute_covariance) result_.covariance_ok = Covariance(columns, &covariance);
     ReportParameters(columns, covariance);
+    if (options_.fit_board_warp) ReportBoardWarp(columns, covariance);
     result_.sensor = Sensor(FittedModel());
     for (size_t v = 0; v < views_; ++v) {
       TargetPose pose;
@@ -540,6 +548,17 @@ class FitRun {
     result_.correlation = CorrelationOf(result_.covariance);
   }
 
+  void ReportBoardWarp(const std::map<const double*, std::vector<int>>& columns, const Eigen::MatrixXd& covariance) {
+    BoardWarpEstimate estimate;
+    estimate.warp = {warp_mm_[0], warp_mm_[1]};
+    const auto found = columns.find(warp_mm_.data());
+    if (result_.covariance_ok && found != columns.end() && found->second[0] >= 0 && found->second[1] >= 0) {
+      estimate.std_x_mm = std::sqrt(std::max(0.0, covariance(found->second[0], found->second[0])));
+      estimate.std_y_mm = std::sqrt(std::max(0.0, covariance(found->second[1], found->second[1])));
+    }
+    result_.board_warp = estimate;
+  }
+
   // The fitted model. Its rim encloses every corner it was fitted on (the fit lets
   // reflections stray up to 15 % past the guess's rim): remap tables and the image area
   // then cover all calibrated image.
@@ -574,6 +593,10 @@ class FitRun {
   std::vector<std::array<double, 4>> rotations_;
   std::vector<std::array<double, 3>> translations_;
   std::map<int, Eigen::Vector3d> corner_points_;
+  // The board's warp block (calib/board_warp.h): present when fitted or held non-zero.
+  bool with_warp_ = false;
+  std::array<double, 2> warp_mm_{{0.0, 0.0}};
+  std::map<int, Eigen::Vector2d> warp_basis_;
   std::unique_ptr<ceres::LossFunctionWrapper> loss_;
   ceres::Problem problem_;
   std::vector<Residual> residuals_;

@@ -96,6 +96,8 @@ struct FitResult {
   // Corner residuals' standard deviation per coordinate (px), from the fit's RMS and its
   // degrees of freedom: what the covariance is scaled by.
   double sigma_px = 0.0;
+  // The board's warp when FitOptions::fit_board_warp (its std from the same covariance).
+  std::optional<BoardWarpEstimate> board_warp;
 };
 
 // The sensor's parameters in FitResult's naming and units (values only, std 0), with

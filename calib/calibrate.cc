@@ -153,6 +153,7 @@ FitOptions FitOptionsFor(const CalibrationInput& input, const CalibrationOptions
   FitOptions fit = FitOptions::DefaultsFor(start);
   if (const std::string why = fit.refine.Hold(options.fixed); !why.empty()) throw InputError(why);
   fit.robust_loss_px = options.loss_px;
+  fit.fit_board_warp = options.board_warp;
   fit.solver.max_num_iterations = options.max_iterations;
   if (const std::string why = fit.Check(); !why.empty()) throw InputError(why);
   fit.tolerances = ExpandTolerances(input.guess_tolerances);
@@ -330,6 +331,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
 
   record.rms_px = fit.rms_px;
   record.rms_all_px = AllCornerRms(fit);
+  record.board_warp = fit.board_warp;
   record.converged = fit.converged;
   record.outliers = fit.outliers;
   record.dropped = fit.dropped;
@@ -411,7 +413,9 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   // two halves' calibrations compared where the user looks.
   if (!holdout_names.empty()) {
     ProgressReporter progress(options.progress, "holdout", 1);
-    record.holdout = EvaluateHeldOutViews(*fit.sensor, input.target, held.detections, fit_options);
+    FitOptions held_options = fit_options;
+    if (fit.board_warp) held_options.board_warp = fit.board_warp->warp;
+    record.holdout = EvaluateHeldOutViews(*fit.sensor, input.target, held.detections, held_options);
     progress.Step();
     for (const auto& [image, why] : record.holdout->not_evaluated)
       warnings.push_back({WarningCode::kViewLeftOut, image, image + ": held-out view not evaluated: " + why});

@@ -55,6 +55,8 @@ struct CalibrationOptions {
   // halves, each calibrated, compared at cross_validation_distance_mm (0: the first of
   // distances_mm / distances_n, else 2 m).
   int holdout_views = 0;
+  // Fit the board's out-of-plane warp (calib/board_warp.h) with the sensor.
+  bool board_warp = false;
   bool cross_validate = false;
   double cross_validation_distance_mm = 0.0;
   DesignTolerances tolerances;  // added to / overriding the guess's

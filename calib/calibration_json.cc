@@ -22,6 +22,9 @@ const char* const kPredictedErrorDefinition =
 const char* const kHoldoutDefinition =
     "views kept out of the fit (spread evenly over the input), their poses fitted with the sensor held; rms_px over "
     "all their corners, per corner sqrt(mean |e|^2); compare with training_rms_px (the fitted views, all corners)";
+const char* const kBoardWarpDefinition =
+    "the board's out-of-plane shape z = x_mm (1 - u^2) + y_mm (1 - v^2) along its normal, u, v the corner's position "
+    "scaled to [-1, 1] over the board's corners: the deflections at the centre relative to the edges (mm)";
 const char* const kCrossValidationDefinition =
     "the usable views split into even and odd positions, each half calibrated alone; the points distance_mm along "
     "each observed field pixel's ray through half 1 (from its reflection point), moved by the rigid motion that "
@@ -68,6 +71,9 @@ json ToJson(const CalibrationRecord& r) {
                        {"inlier_fraction", r.rim_circle->inlier_fraction},
                        {"rms_px", r.rim_circle->rms_px}};
   for (const auto& [name, s] : r.leave_one_out) j["leave_one_out"][name] = {{"min", s.min}, {"max", s.max}, {"std", s.std}};
+  if (const auto& w = r.board_warp)
+    j["board_warp"] = {{"x_mm", w->warp.x_mm}, {"y_mm", w->warp.y_mm}, {"std_x_mm", NumberOrNull(w->std_x_mm)},
+                       {"std_y_mm", NumberOrNull(w->std_y_mm)}, {"definition", kBoardWarpDefinition}};
   if (const auto& h = r.holdout) {
     json& out = j["holdout"];
     out["views"] = h->images;
@@ -167,6 +173,11 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
       for (const auto& [parameter, s] : at("leave_one_out").items())
         r.leave_one_out[parameter] = {s.at("min").get<double>(), s.at("max").get<double>(), s.at("std").get<double>()};
     if (j.contains("rms_all_px")) r.rms_all_px = NumberOrNan(at("rms_all_px"));
+    if (j.contains("board_warp")) {
+      const json& w = at("board_warp");
+      r.board_warp = BoardWarpEstimate{{w.at("x_mm").get<double>(), w.at("y_mm").get<double>()},
+                                       NumberOrNan(w.at("std_x_mm")), NumberOrNan(w.at("std_y_mm"))};
+    }
     if (j.contains("holdout")) {
       const json& h = at("holdout");
       HeldOutViews held;

@@ -42,6 +42,7 @@ struct CalibrationRecord {
   // Views kept out of the fit and evaluated with the sensor held (CalibrationOptions::
   // holdout_views); the training RMS to compare with is rms_all_px / rms_px.
   std::optional<HeldOutViews> holdout;
+  std::optional<BoardWarpEstimate> board_warp;  // when fitted (CalibrationOptions::board_warp)
   // The two halves' calibrations compared (CalibrationOptions::cross_validate). The diff's
   // per-pixel vectors are kept in memory for the report's figure; the file has the summary.
   struct CrossValidationRecord {

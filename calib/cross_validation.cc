@@ -58,6 +58,7 @@ HeldOutViews EvaluateHeldOutViews(const Sensor& sensor, const CalibrationTarget&
   options.tolerances.clear();
   options.design.clear();
   options.compute_covariance = false;
+  options.fit_board_warp = false;  // held at options.board_warp, the training fit's
   options.view_rms_ratio = HUGE_VAL;
   options.progress = nullptr;
   const FitResult fit = FitSensor(sensor, target, posed, poses, options);

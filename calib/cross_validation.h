@@ -42,7 +42,7 @@ struct HeldOutViews {
 
 // The views' poses fitted with `sensor` held (robust loss and outlier rule as in
 // `options`; every view kept however it fits: a held-out view is a measurement, not a
-// suspect).
+// suspect). The board's warp is held at options.board_warp (the training fit's).
 HeldOutViews EvaluateHeldOutViews(const Sensor& sensor, const CalibrationTarget& target, const DetectionSet& views,
                                   FitOptions options);
 

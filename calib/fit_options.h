@@ -8,6 +8,7 @@
 #include <set>
 #include <string>
 
+#include "calib/board_warp.h"
 #include "model/parameter_field.h"
 #include "model/progress.h"
 #include "model/sensor.h"
@@ -70,6 +71,10 @@ struct FitOptions {
   // a parameter not named here is centred on the guess's value. A pipeline that fits
   // several times (a second detection pass from the first fit) keeps the user's design.
   std::map<std::string, double> design;
+  // The board's out-of-plane warp (calib/board_warp.h): fitted with the sensor when
+  // fit_board_warp, else held at board_warp (zero: a flat board).
+  bool fit_board_warp = false;
+  BoardWarp board_warp;
   // Stage "fit", one step per solver iteration; returning false cancels (Cancelled).
   ProgressCallback progress;
 

@@ -9,6 +9,8 @@
 //   shape       the profile's NumParams(), its ToParams order; absent when 0 (tabulated)
 //   rotation    4: camera_from_target as Eigen's quaternion coefficients x, y, z, w
 //   translation 3: camera_from_target (mm)
+//   warp        2 (mm), only when the cost is created with a warp basis: the board's
+//               out-of-plane deflection at its centre along its x and y axes (BoardWarp)
 // Residual: predicted minus observed pixel (2). Evaluation fails (returns false) where the
 // optics have no reflection point: Ceres then treats the step as invalid.
 #pragma once
@@ -18,6 +20,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <optional>
 #include <vector>
 
 #include "model/catadioptric.h"
@@ -30,8 +33,10 @@ class ReprojectionCost {
   using Model = Catadioptric<double, Profile, Lens>;
 
   // base: the rim, image size, the profile's parameter count (a tabulated profile's table).
-  ReprojectionCost(const Model& base, const Eigen::Vector3d& point_in_target_mm, const Eigen::Vector2d& observed_px)
-      : base_(base), point_in_target_mm_(point_in_target_mm), observed_px_(observed_px) {
+  // warp_basis: the corner's BoardWarp::Basis when the warp block is present.
+  ReprojectionCost(const Model& base, const Eigen::Vector3d& point_in_target_mm, const Eigen::Vector2d& observed_px,
+                   const std::optional<Eigen::Vector2d>& warp_basis = std::nullopt)
+      : base_(base), point_in_target_mm_(point_in_target_mm), observed_px_(observed_px), warp_basis_(warp_basis) {
     // The corner was detected, so its reflection lies on the mirror; iterates may stray a
     // little past the rim, where the profile is still defined.
     base_.rim_radius_mm = std::min(1.15 * base.rim_radius_mm, 0.99 * base.mirror.MaxRadiusMm());
@@ -48,8 +53,9 @@ class ReprojectionCost {
     model.image_width_px = base_.image_width_px;
     model.image_height_px = base_.image_height_px;
     const Eigen::Quaternion<T> rotation(p[next][3], p[next][0], p[next][1], p[next][2]);
-    const Vec3<T> in_camera =
-        rotation * point_in_target_mm_.cast<T>() + Vec3<T>(p[next + 1][0], p[next + 1][1], p[next + 1][2]);
+    Vec3<T> in_target = point_in_target_mm_.cast<T>();
+    if (warp_basis_) in_target.z() += p[next + 2][0] * T(warp_basis_->x()) + p[next + 2][1] * T(warp_basis_->y());
+    const Vec3<T> in_camera = rotation * in_target + Vec3<T>(p[next + 1][0], p[next + 1][1], p[next + 1][2]);
     Vec3<T> mirror_point;
     // The corner was detected: no image-bounds or occlusion test, only the optics.
     if (model.ReflectionPoint(in_camera, &mirror_point) != ProjectionStatus::kOk) return false;
@@ -61,20 +67,22 @@ class ReprojectionCost {
   }
 
   // The blocks' sizes, in the order above.
-  static std::vector<int> BlockSizes(const Model& base) {
+  static std::vector<int> BlockSizes(const Model& base, bool with_warp = false) {
     std::vector<int> sizes = {Lens<double>::kNumParams, 1, 2, 2};
     if (base.mirror.NumParams() > 0) sizes.push_back(base.mirror.NumParams());
     sizes.push_back(4);
     sizes.push_back(3);
+    if (with_warp) sizes.push_back(2);
     return sizes;
   }
 
   // Automatic derivatives (Jets through the implicit solve: model/catadioptric.h).
   static ceres::CostFunction* Create(const Model& base, const Eigen::Vector3d& point_in_target_mm,
-                                     const Eigen::Vector2d& observed_px) {
+                                     const Eigen::Vector2d& observed_px,
+                                     const std::optional<Eigen::Vector2d>& warp_basis = std::nullopt) {
     auto* cost = new ceres::DynamicAutoDiffCostFunction<ReprojectionCost, 8>(
-        new ReprojectionCost(base, point_in_target_mm, observed_px));
-    for (int size : BlockSizes(base)) cost->AddParameterBlock(size);
+        new ReprojectionCost(base, point_in_target_mm, observed_px, warp_basis));
+    for (int size : BlockSizes(base, warp_basis.has_value())) cost->AddParameterBlock(size);
     cost->SetNumResiduals(2);
     return cost;
   }
@@ -87,6 +95,7 @@ class ReprojectionCost {
   Model base_;
   Eigen::Vector3d point_in_target_mm_;
   Eigen::Vector2d observed_px_;
+  std::optional<Eigen::Vector2d> warp_basis_;
 };
 
 // The cost of a model type. Deduced from the Catadioptric's own template arguments: clang

@@ -81,6 +81,9 @@ void Run(Options options, const Context& context) {
     }
   }
   std::printf("all fitted corners, outliers included: RMS %.4f px\n", result.record.rms_all_px);
+  if (const auto& warp = result.record.board_warp)
+    std::printf("board warp: %.3f +- %.3f mm along x, %.3f +- %.3f mm along y (deflection at the centre)\n",
+                warp->warp.x_mm, warp->std_x_mm, warp->warp.y_mm, warp->std_y_mm);
   if (const auto& held = result.record.holdout)
     std::printf("held out: %zu views, %d corners: RMS %.4f px (training %.4f px, ratio %.2f)\n", held->images.size(),
                 held->corners, held->rms_px, result.record.rms_all_px, held->rms_px / result.record.rms_all_px);
@@ -141,6 +144,9 @@ Command CalibrateCommand() {
                            "Keep K views (spread evenly) out of the fit and report their RMS with the sensor held "
                            "(their poses fitted): how well the calibration predicts new views")
                 ->check(CLI::Range(0, 10000));
+            sub.add_flag("--board-warp", library.board_warp,
+                         "Also fit the board's out-of-plane warp (a paraboloid along each board axis, mm at the centre; "
+                         "paper boards bend)");
             sub.add_flag("--cross-validate", library.cross_validate,
                          "Also calibrate each half of the views (even / odd) and report how far the two disagree over "
                          "the observed field after the best rigid alignment (report/cross_validation.png)");

@@ -227,7 +227,7 @@ fi
 # the halves of 3 views each differ by 0.32 px RMS at 1 m (bound 1 px: a sanity bound, the
 # library tests check the numbers against known answers).
 if "$omnical" -q calibrate --target "$grid" --detections "$work/det.json" --sensor "$guess" --out "$work/cal_cv" \
-    --holdout 2 --cross-validate --cross-validate-distance-mm 1000 2>/dev/null; then
+    --holdout 2 --cross-validate --cross-validate-distance-mm 1000 --board-warp 2>/dev/null; then
   python3 - "$work/cal_cv/calibration.json" <<'PYCV' && pass || fail "calibrate --holdout --cross-validate"
 import json, sys
 d = json.load(open(sys.argv[1]))
@@ -236,7 +236,10 @@ ok = len(h["views"]) == 2 and h["corners"] > 0 and 0 < h["rms_px"] < 2 * h["trai
 ok &= not any(v in d["per_view_rms_px"] for v in h["views"])  # kept out of the fit
 ok &= c["distance_mm"] == 1000 and c["grid_points"] > 100 and 0 <= c["diff_rms_px"] < 1.0
 ok &= sorted(c["halves"][0] + c["halves"][1]) == sorted(d["per_view_rms_px"])
-print(f"holdout {h['rms_px']:.3f} vs {h['training_rms_px']:.3f} px; halves differ {c['diff_rms_px']:.3f} px")
+w = d["board_warp"]  # the rendered board is flat: its warp is zero within 3 std
+ok &= 0 < w["std_x_mm"] < 1 and 0 < w["std_y_mm"] < 1 and abs(w["x_mm"]) < 3 * w["std_x_mm"] and abs(w["y_mm"]) < 3 * w["std_y_mm"]
+print(f"holdout {h['rms_px']:.3f} vs {h['training_rms_px']:.3f} px; halves differ {c['diff_rms_px']:.3f} px; "
+      f"warp {w['x_mm']:.3f} +- {w['std_x_mm']:.3f}, {w['y_mm']:.3f} +- {w['std_y_mm']:.3f} mm")
 sys.exit(0 if ok else 1)
 PYCV
   [ -s "$work/cal_cv/report/cross_validation.png" ] && [ -s "$work/cal_cv/report/holdout.png" ] && pass ||

@@ -280,13 +280,13 @@ def test_calibrate_from_detections_without_guess_with_leave_one_out(runs, tmp_pa
 
 
 def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
-    """Held-out views, the two halves and omnical.diff: both front ends, the same numbers."""
+    """Held-out views, the two halves, the board's warp and omnical.diff: both front ends, the same numbers."""
     detections = runs.out / "cli" / "detections.json"
     result, done = beside_cli(
         ["-q", "calibrate", "--target", TARGET, "--detections", detections, "--sensor", GUESS, "--holdout", 2,
-         "--cross-validate", "--cross-validate-distance-mm", 1500, "--out", tmp_path / "cli"],
+         "--cross-validate", "--cross-validate-distance-mm", 1500, "--board-warp", "--out", tmp_path / "cli"],
         lambda: omnical.calibrate(TARGET, detections=detections, guess=GUESS, holdout=2, cross_validate=True,
-                                  cross_validation_distance_mm=1500))
+                                  cross_validation_distance_mm=1500, board_warp=True))
     assert done.returncode == 0, done.stderr
     cli = json.loads((tmp_path / "cli" / "calibration.json").read_text())
     assert_json_equal(json.loads(result.to_json()), cli)
@@ -297,6 +297,9 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
     assert [list(h) for h in cross["halves"]] == cli["cross_validation"]["halves"]
     assert close(cross["rms_px"], cli["cross_validation"]["diff_rms_px"]) and cross["distance_mm"] == 1500
     assert omnical.load_calibration(tmp_path / "cli" / "calibration.json").holdout["views"] == held["views"]
+    warp = result.board_warp
+    assert close(warp["x_mm"], cli["board_warp"]["x_mm"]) and close(warp["std_y_mm"], cli["board_warp"]["std_y_mm"])
+    assert omnical.calibrate(TARGET, detections=detections, guess=GUESS, max_iterations=1).board_warp is None
 
     # diff: the full calibration against the held-out one, over the detections' annulus.
     done = run_cli("-q", "diff", runs.out / "cli", tmp_path / "cli", "--field", detections, "--distance-mm", 1500,

@@ -235,6 +235,16 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
       },
       "dict parameter -> {'min', 'max', 'std'} over the fits without each view (empty unless leave_one_out=True).");
   cls.def_property_readonly(
+      "board_warp",
+      [record](const Holder& holder) -> py::object {
+        const auto& w = record(holder).board_warp;
+        if (!w) return py::none();
+        return py::dict("x_mm"_a = w->warp.x_mm, "y_mm"_a = w->warp.y_mm, "std_x_mm"_a = w->std_x_mm,
+                        "std_y_mm"_a = w->std_y_mm);
+      },
+      "The board's fitted warp (board_warp=True): dict x_mm, y_mm (deflection at the centre along each board axis) "
+      "and their std_x_mm, std_y_mm; None unless fitted.");
+  cls.def_property_readonly(
       "holdout",
       [record](const Holder& holder) -> py::object {
         const CalibrationRecord& r = record(holder);
@@ -333,7 +343,8 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
                         int max_iterations, int detection_passes, int threads, bool leave_one_out,
                         const py::object& tolerances, const std::vector<double>& distances_mm,
                         const std::vector<double>& distances_n, double max_predicted_error_px, double rim_field_deg,
-                        int holdout, bool cross_validate, double cross_validation_distance_mm, py::object progress) {
+                        int holdout, bool cross_validate, double cross_validation_distance_mm, bool board_warp,
+                        py::object progress) {
   CalibrationInput input;
   PyTarget target = TargetOf(target_arg);
   input.target = std::move(target.board);
@@ -371,6 +382,7 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
   options.max_predicted_error_px = max_predicted_error_px;
   options.rim_field_deg = rim_field_deg;
   options.holdout_views = holdout;
+  options.board_warp = board_warp;
   options.cross_validate = cross_validate;
   options.cross_validation_distance_mm = cross_validation_distance_mm;
   options.progress = ForwardProgress(std::move(progress));
@@ -642,7 +654,8 @@ are also attributes here), the warnings with their codes, the views and residual
         "detection_passes"_a = 2, "threads"_a = 0, "leave_one_out"_a = false, "tolerances"_a = py::none(),
         "distances_mm"_a = std::vector<double>(), "distances_n"_a = std::vector<double>(),
         "max_predicted_error_px"_a = 0.3, "rim_field_deg"_a = kDefaultRimFieldDeg, "holdout"_a = 0,
-        "cross_validate"_a = false, "cross_validation_distance_mm"_a = 0.0, "progress"_a = py::none(),
+        "cross_validate"_a = false, "cross_validation_distance_mm"_a = 0.0, "board_warp"_a = false,
+        "progress"_a = py::none(),
         R"(Calibrates the sensor (as `omnical calibrate`) -> CalibrationResult.
 
 target: a Target or a spec path. Corners: images (as detect(): a directory or glob, a
@@ -659,7 +672,8 @@ distances_mm / distances_n: where to predict the projection error (mm, or rim ra
 max_predicted_error_px: warn above it. holdout: K views (spread evenly) kept out of the
 fit and evaluated with the sensor held (result.holdout). cross_validate: each half of the
 views calibrated and compared at cross_validation_distance_mm (0: the first distance
-asked, else 2000) after the best rigid alignment (result.cross_validation).
+asked, else 2000) after the best rigid alignment (result.cross_validation). board_warp:
+also fit the board's out-of-plane warp (result.board_warp, mm).
 progress(stage, done, total): False cancels.
 Raises InputError with the library's message (too few views, a bad file, a bad value).)");
 

@@ -1,0 +1,32 @@
+// A printed board is rarely flat: paper on card bends, a hand-held board sags. The warp is
+// the board's out-of-plane shape, a paraboloid along each board axis (mrcal's
+// calobject_warp): z = x_mm (1 - u^2) + y_mm (1 - v^2) along the board's normal, u and v
+// the corner's position scaled to [-1, 1] over the extent of the board's corners. So x_mm
+// and y_mm are the deflections at the centre relative to the edges, in mm. One warp per
+// board, shared by every view (the same sheet in every image).
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <map>
+
+#include "calib/target.h"
+
+namespace omnical {
+
+struct BoardWarp {
+  double x_mm = 0.0, y_mm = 0.0;
+
+  // Per corner id the factors (1 - u^2, 1 - v^2) the deflections multiply.
+  static std::map<int, Eigen::Vector2d> Basis(const CalibrationTarget& target);
+  // The out-of-plane offset of a corner with that basis (mm).
+  double OffsetMm(const Eigen::Vector2d& basis) const { return x_mm * basis.x() + y_mm * basis.y(); }
+  bool IsZero() const { return x_mm == 0.0 && y_mm == 0.0; }
+};
+
+struct BoardWarpEstimate {
+  BoardWarp warp;
+  double std_x_mm = NAN, std_y_mm = NAN;  // from the fit's covariance (NaN without one)
+};
+
+}  // namespace omnical
