@@ -4,20 +4,47 @@
 
 namespace omnical {
 
+WarpedSurface WarpedSurface::Of(const CalibrationTarget& target, const BoardWarp& warp) {
+  WarpedSurface surface;
+  surface.warp = warp;
+  surface.low_mm = Eigen::Vector2d::Constant(HUGE_VAL);
+  surface.high_mm = Eigen::Vector2d::Constant(-HUGE_VAL);
+  for (const TargetCorner& c : target.corners()) {
+    surface.low_mm = surface.low_mm.cwiseMin(c.point_in_target.head<2>());
+    surface.high_mm = surface.high_mm.cwiseMax(c.point_in_target.head<2>());
+  }
+  if (target.corners().empty()) surface.low_mm = surface.high_mm = Eigen::Vector2d::Zero();
+  return surface;
+}
+
+Eigen::Vector2d WarpedSurface::BasisAt(double x_mm, double y_mm) const {
+  const Eigen::Vector2d point(x_mm, y_mm);
+  Eigen::Vector2d basis = Eigen::Vector2d::Zero();  // a board one corner wide along an axis cannot bend along it
+  for (int k = 0; k < 2; ++k)
+    if (high_mm[k] > low_mm[k]) {
+      const double unit = 2.0 * (point[k] - low_mm[k]) / (high_mm[k] - low_mm[k]) - 1.0;
+      basis[k] = 1.0 - unit * unit;
+    }
+  return basis;
+}
+
+Eigen::Vector2d WarpedSurface::Slope(double x_mm, double y_mm) const {
+  const Eigen::Vector2d point(x_mm, y_mm);
+  const double deflection[2] = {warp.x_mm, warp.y_mm};
+  Eigen::Vector2d slope = Eigen::Vector2d::Zero();
+  for (int k = 0; k < 2; ++k)
+    if (high_mm[k] > low_mm[k]) {
+      const double span = high_mm[k] - low_mm[k];
+      const double unit = 2.0 * (point[k] - low_mm[k]) / span - 1.0;
+      slope[k] = deflection[k] * -2.0 * unit * 2.0 / span;
+    }
+  return slope;
+}
+
 std::map<int, Eigen::Vector2d> BoardWarp::Basis(const CalibrationTarget& target) {
-  Eigen::Vector2d low = Eigen::Vector2d::Constant(HUGE_VAL), high = Eigen::Vector2d::Constant(-HUGE_VAL);
-  for (const TargetCorner& c : target.corners()) {
-    low = low.cwiseMin(c.point_in_target.head<2>());
-    high = high.cwiseMax(c.point_in_target.head<2>());
-  }
+  const WarpedSurface surface = WarpedSurface::Of(target, BoardWarp());
   std::map<int, Eigen::Vector2d> basis;
-  for (const TargetCorner& c : target.corners()) {
-    Eigen::Vector2d unit = Eigen::Vector2d::Zero();  // a board one corner wide along an axis cannot bend along it
-    for (int k = 0; k < 2; ++k)
-      if (high[k] > low[k]) unit[k] = 2.0 * (c.point_in_target[k] - low[k]) / (high[k] - low[k]) - 1.0;
-    basis[c.id] = Eigen::Vector2d(high.x() > low.x() ? 1.0 - unit.x() * unit.x() : 0.0,
-                                  high.y() > low.y() ? 1.0 - unit.y() * unit.y() : 0.0);
-  }
+  for (const TargetCorner& c : target.corners()) basis[c.id] = surface.BasisAt(c.point_in_target.x(), c.point_in_target.y());
   return basis;
 }
 

@@ -24,6 +24,20 @@ struct BoardWarp {
   bool IsZero() const { return x_mm == 0.0 && y_mm == 0.0; }
 };
 
+// The warp over one board's extent, at any board point (x, y) mm: for rendering bent
+// boards and their corners (calib/synthetic).
+struct WarpedSurface {
+  BoardWarp warp;
+  Eigen::Vector2d low_mm = Eigen::Vector2d::Zero(), high_mm = Eigen::Vector2d::Zero();  // the corners' extent
+
+  static WarpedSurface Of(const CalibrationTarget& target, const BoardWarp& warp);
+  // (1 - u^2, 1 - v^2); 0 along an axis the corners do not span.
+  Eigen::Vector2d BasisAt(double x_mm, double y_mm) const;
+  double OffsetMm(double x_mm, double y_mm) const { return warp.OffsetMm(BasisAt(x_mm, y_mm)); }
+  // d offset / d (x, y).
+  Eigen::Vector2d Slope(double x_mm, double y_mm) const;
+};
+
 struct BoardWarpEstimate {
   BoardWarp warp;
   double std_x_mm = NAN, std_y_mm = NAN;  // from the fit's covariance (NaN without one)

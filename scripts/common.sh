@@ -15,7 +15,7 @@ omnical_packages=(
   libopencv-dev libopencv-contrib-dev libapriltag-dev
   libgtest-dev libgmock-dev libbenchmark-dev python3
   ffmpeg python3-numpy
-  python3-dev pybind11-dev python3-pytest python3-matplotlib python3-opencv
+  python3-dev pybind11-dev python3-pytest python3-matplotlib python3-opencv python3-mrcal
 )
 
 install_dependencies() {

@@ -174,7 +174,7 @@ Observations ObservationsAround(const Sensor& truth, int views, unsigned seed, d
   out.detections.image_height_px = truth.image_height_px();
   for (int k = 0; k < views; ++k) {
     SceneView view;
-    PlacedTarget placed{"board", board, "", Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
+    PlacedTarget placed{"board", board, "", Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), {}};
     const double distance_mm =
         kRimMm * nearest_rims * std::pow(farthest_rims / nearest_rims, static_cast<double>(k) / (views - 1));
     PlaceTarget(truth, *board, 60.0 + 50.0 * unit(rng), 360.0 * k / views + 20.0 * unit(rng), distance_mm,

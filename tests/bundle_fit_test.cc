@@ -43,7 +43,7 @@ std::vector<SceneView> MixedDistanceViews(const Sensor& sensor) {
   std::vector<SceneView> views;
   for (int k = 0; k < 16; ++k) {
     SceneView view;
-    PlacedTarget placed{"board", board, "", Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
+    PlacedTarget placed{"board", board, "", Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), {}};
     const double distance = testing::kRimMm * 4.0 * std::pow(30.0 / 4.0, k / 15.0);
     PlaceTarget(sensor, *board, 40.0 + 80.0 * unit(rng), 360.0 * unit(rng), distance, 60.0 * unit(rng) - 30.0,
                 30.0 * unit(rng) - 15.0, 30.0 * unit(rng) - 15.0, &placed.camera_from_target_rotation,

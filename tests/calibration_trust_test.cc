@@ -52,7 +52,7 @@ DetectionSet ExactViews(const CalibrationTarget& board, const Placement& placeme
   const double azimuth_step_deg = 360.0 / placement.views;
   for (int k = 0; k < placement.views; ++k) {
     SceneView view;
-    PlacedTarget placed{"board", shared, "", Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
+    PlacedTarget placed{"board", shared, "", Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), {}};
     const double omega_deg = placement.omega_low_deg + (placement.omega_high_deg - placement.omega_low_deg) * unit(rng);
     const double azimuth_deg = azimuth_step_deg * k + placement.azimuth_jitter_deg * unit(rng);
     const double distance_n = placement.distance_low_n + (placement.distance_high_n - placement.distance_low_n) * unit(rng);

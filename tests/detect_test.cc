@@ -401,7 +401,7 @@ TEST(DetectCheckerboard, NumbersTheCornersAsThePrintedBoard) {
   for (const Case& c : {Case{7, 6, 180.0, 40.0}, Case{7, 6, 100.0, 200.0}, Case{8, 6, 60.0, 120.0}, Case{8, 6, -30.0, 60.0}}) {
     const auto board = std::make_shared<const CalibrationTarget>(CalibrationTarget::Checkerboard(c.cols, c.rows, 30.0, 30.0));
     SceneView view;
-    PlacedTarget placed{"board", board, "", Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
+    PlacedTarget placed{"board", board, "", Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), {}};
     PlaceTarget(sensor, *board, 95.0, c.azimuth_deg, 7.0 * testing::kRimMm, c.roll_deg, 10.0, 0.0,
                 &placed.camera_from_target_rotation, &placed.camera_from_target_translation_mm);
     view.targets.push_back(placed);

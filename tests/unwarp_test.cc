@@ -42,7 +42,7 @@ TEST_P(UnwarpedPanorama, CorrectedTablesPutCornersWhereTheIdealCentralCameraSees
   const auto board = std::make_shared<const CalibrationTarget>(CalibrationTarget::AprilGrid(4, 3, c.tag_mm, 0.3));
   // The board faces the mirror vertex 10 deg below the horizon (Omega 80).
   SceneView view;
-  PlacedTarget placed{"board", board, "", Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()};
+  PlacedTarget placed{"board", board, "", Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), {}};
   const double omega_deg = 80.0, azimuth_deg = 25.0;
   PlaceTarget(sensor, *board, omega_deg, azimuth_deg, distance, 0.0, 0.0, 0.0, &placed.camera_from_target_rotation,
               &placed.camera_from_target_translation_mm);

@@ -10,10 +10,10 @@
 namespace omnical {
 
 std::string GroundTruthJsonText(const SceneView& view, const std::vector<TargetTruth>& truth, const std::string& out_dir,
-                                const std::string& sensor_yaml, const Sensor& sensor) {
+                                const std::string& sensor_yaml, const Sensor& sensor, const std::string& image_file) {
   nlohmann::json out;
   out["view"] = view.name;
-  out["image"] = view.name + ".png";
+  out["image"] = image_file;
   out["image_size"] = {sensor.image_width_px(), sensor.image_height_px()};
   out["sensor_file"] = "sensor.yaml";
   out["sensor_yaml"] = sensor_yaml;
@@ -33,6 +33,7 @@ std::string GroundTruthJsonText(const SceneView& view, const std::vector<TargetT
                                {"translation_mm",
                                 {placed.camera_from_target_translation_mm.x(), placed.camera_from_target_translation_mm.y(),
                                  placed.camera_from_target_translation_mm.z()}}};
+    t["warp_mm"] = {placed.surface.warp.x_mm, placed.surface.warp.y_mm};
     int visible = 0;
     for (const CornerTruth& c : target.corners) {
       nlohmann::json corner;
@@ -51,6 +52,10 @@ std::string GroundTruthJsonText(const SceneView& view, const std::vector<TargetT
   return out.dump(1) + '\n';
 }
 
+
+std::string RenderedImageName(const SceneView& view, const ImageFormation& formation) {
+  return view.name + (formation.jpeg_quality > 0 ? ".jpg" : ".png");
+}
 
 DetectionSet DetectionsFromGroundTruth(const std::vector<std::string>& truth_paths) {
   DetectionSet set;

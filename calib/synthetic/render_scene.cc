@@ -49,13 +49,18 @@ void WriteRenderedScene(const Scene& scene, const std::string& scene_path, const
   std::vector<std::string> truths(views.size());
   for (size_t k = 0; k < views.size(); ++k) {
     const SceneView& view = *views[k].view;
-    cv::imencode(".png", views[k].image, pngs[k], {cv::IMWRITE_PNG_COMPRESSION, 9});
-    truths[k] = GroundTruthJsonText(view, views[k].truth, dir_name, sensor_yaml, sensor);
-    index["views"].push_back({{"name", view.name}, {"image", view.name + ".png"}, {"truth", view.name + ".json"}});
+    const std::string image_name = RenderedImageName(view, scene.formation);
+    if (scene.formation.jpeg_quality > 0) {
+      cv::imencode(".jpg", views[k].image, pngs[k], {cv::IMWRITE_JPEG_QUALITY, scene.formation.jpeg_quality});
+    } else {
+      cv::imencode(".png", views[k].image, pngs[k], {cv::IMWRITE_PNG_COMPRESSION, 9});
+    }
+    truths[k] = GroundTruthJsonText(view, views[k].truth, dir_name, sensor_yaml, sensor, image_name);
+    index["views"].push_back({{"name", view.name}, {"image", image_name}, {"truth", view.name + ".json"}});
   }
   for (size_t k = 0; k < views.size(); ++k) {
     const std::vector<uchar>& png = pngs[k];
-    WriteFileAtomically((dir / (views[k].view->name + ".png")).string(), [&](std::ostream& out) {
+    WriteFileAtomically((dir / RenderedImageName(*views[k].view, scene.formation)).string(), [&](std::ostream& out) {
       out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
     });
     WriteFileAtomically((dir / (views[k].view->name + ".json")).string(), [&](std::ostream& out) { out << truths[k]; });

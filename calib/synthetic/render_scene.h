@@ -22,7 +22,7 @@ struct RenderOptions {
 
 struct RenderedView {
   const SceneView* view;  // into the scene rendered
-  cv::Mat image;          // 8-bit grey
+  cv::Mat image;          // 8-bit grey, or BGR (ImageFormation::colour)
   std::vector<TargetTruth> truth;
 };
 

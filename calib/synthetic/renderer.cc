@@ -22,7 +22,21 @@ bool HitTarget(const PlacedTarget& placed, const Eigen::Vector3d& origin, const 
   const Eigen::Vector3d normal = placed.camera_from_target_rotation.col(2);
   const double along = direction.dot(normal);
   if (std::abs(along) < 1e-12) return false;
-  const double t = (placed.camera_from_target_translation_mm - origin).dot(normal) / along;
+  double t = (placed.camera_from_target_translation_mm - origin).dot(normal) / along;
+  // A bent board: Newton from the flat plane's hit on z - offset(x, y) = 0 along the ray
+  // (a few mm of bend over a board's width: converged to 1e-9 mm in 2-3 steps).
+  if (!placed.surface.warp.IsZero()) {
+    const Eigen::Vector3d o = placed.camera_from_target_rotation.transpose() * (origin - placed.camera_from_target_translation_mm);
+    const Eigen::Vector3d d = placed.camera_from_target_rotation.transpose() * direction;
+    for (int step = 0; step < 8; ++step) {
+      const Eigen::Vector3d p = o + t * d;
+      const double f = p.z() - placed.surface.OffsetMm(p.x(), p.y());
+      const double slope = d.z() - placed.surface.Slope(p.x(), p.y()).dot(d.head<2>());
+      if (std::abs(slope) < 1e-12) return false;
+      t -= f / slope;
+      if (std::abs(f) < 1e-9) break;
+    }
+  }
   if (!(t > 0.0)) return false;
   const Eigen::Vector3d in_target =
       placed.camera_from_target_rotation.transpose() * (origin + t * direction - placed.camera_from_target_translation_mm);
@@ -100,14 +114,24 @@ cv::Mat RenderView(const Sensor& sensor, const PixelRayGrid& rays, const SceneVi
   }
   cv::Mat grey = radiance * 255.0;
   if (formation.blur_sigma_px > 0.0) cv::GaussianBlur(grey, grey, cv::Size(0, 0), formation.blur_sigma_px);
+  // Colour: a warm white balance (B, G, R gains of an indoor scene under tungsten light,
+  // uncorrected), each channel with its own noise, as a Bayer camera's demosaiced output.
+  std::vector<cv::Mat> channels;
+  if (formation.colour) {
+    for (double gain : {0.72, 0.9, 1.0}) channels.push_back(grey * gain);
+  } else {
+    channels.push_back(grey);
+  }
   if (formation.noise_sigma > 0.0) {
     std::mt19937_64 rng(static_cast<uint64_t>(formation.seed) * 1000003ull + view_index);
     std::normal_distribution<double> noise(0.0, formation.noise_sigma);
     for (int v = 0; v < height; ++v)
-      for (int u = 0; u < width; ++u) grey.at<double>(v, u) += noise(rng);
+      for (int u = 0; u < width; ++u)
+        for (cv::Mat& channel : channels) channel.at<double>(v, u) += noise(rng);
   }
-  cv::Mat image;
-  grey.convertTo(image, CV_8U);  // rounds and saturates
+  cv::Mat merged, image;
+  cv::merge(channels, merged);
+  merged.convertTo(image, formation.colour ? CV_8UC3 : CV_8U);  // rounds and saturates
   return image;
 }
 
@@ -119,8 +143,9 @@ std::vector<TargetTruth> GroundTruth(const Sensor& sensor, const SceneView& view
     for (const TargetCorner& corner : placed.target->corners()) {
       CornerTruth c;
       c.id = corner.id;
-      c.point_in_target_mm = corner.point_in_target;
-      c.point_in_camera_mm = placed.camera_from_target_rotation * corner.point_in_target + placed.camera_from_target_translation_mm;
+      c.point_in_target_mm = corner.point_in_target +
+                             Eigen::Vector3d(0.0, 0.0, placed.surface.OffsetMm(corner.point_in_target.x(), corner.point_in_target.y()));
+      c.point_in_camera_mm = placed.camera_from_target_rotation * c.point_in_target_mm + placed.camera_from_target_translation_mm;
       c.pixel = Eigen::Vector2d::Constant(NAN);
       Eigen::Vector3d mirror_point;
       c.status = std::visit(

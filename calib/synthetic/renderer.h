@@ -14,15 +14,15 @@
 
 namespace omnical {
 
-// 8-bit grey image of one view. Deterministic: the noise comes from formation.seed and
-// the view index, independently of the number of threads.
+// 8-bit image of one view: grey, or BGR with formation.colour. Deterministic: the noise
+// comes from formation.seed and the view index, independently of the number of threads.
 cv::Mat RenderView(const Sensor& sensor, const PixelRayGrid& rays, const SceneView& view,
                    const Environment& environment, const ImageFormation& formation, unsigned view_index, int threads,
                    const std::function<void(long)>& progress = nullptr);
 
 // Ground truth of one view: every target corner's exact pixel (exact projection) and
 // whether it is visible: imaged (status ok), seen from its printed side, and not hidden
-// by another target.
+// by another target. A bent board's corners lie on its surface (PlacedTarget::surface).
 struct CornerTruth {
   int id;
   Eigen::Vector3d point_in_target_mm, point_in_camera_mm;

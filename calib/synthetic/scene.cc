@@ -87,7 +87,8 @@ Scene LoadSceneYaml(const std::string& path) {
     const double rim = scene.sensor->rim_radius_mm();
 
     if (const YAML::Node render = root["render"]) {
-      reader.RejectUnknown(render, "render", {"samples_per_pixel", "noise_sigma", "blur_sigma_px", "vignetting", "seed"});
+      reader.RejectUnknown(render, "render",
+                           {"samples_per_pixel", "noise_sigma", "blur_sigma_px", "vignetting", "seed", "jpeg_quality", "colour"});
       ImageFormation& f = scene.formation;
       const double spp = reader.NumberOr(render, "samples_per_pixel", "render", 16);
       const int side = static_cast<int>(std::lround(std::sqrt(spp)));
@@ -101,6 +102,15 @@ Scene LoadSceneYaml(const std::string& path) {
       if (f.noise_sigma < 0.0 || f.noise_sigma > 100.0) reader.Fail("render.noise_sigma", "must be in [0, 100] grey levels");
       if (f.blur_sigma_px < 0.0 || f.blur_sigma_px > 50.0) reader.Fail("render.blur_sigma_px", "must be in [0, 50] px");
       if (f.vignetting < 0.0 || f.vignetting > 1.0) reader.Fail("render.vignetting", "must be in [0, 1]");
+      const double quality = reader.NumberOr(render, "jpeg_quality", "render", 0);
+      if (!(quality >= 0 && quality <= 100) || quality != std::floor(quality))
+        reader.Fail("render.jpeg_quality", "must be 0 (PNG) or a JPEG quality 1 to 100");
+      f.jpeg_quality = static_cast<int>(quality);
+      if (render["colour"]) {
+        const std::string colour = reader.Text(render["colour"], "render.colour");
+        if (colour != "true" && colour != "false") reader.Fail("render.colour", "must be true or false");
+        f.colour = colour == "true";
+      }
     }
     if (const YAML::Node env = root["environment"]) {
       reader.RejectUnknown(env, "environment", {"type", "level", "half_size_mm", "tile_mm", "levels", "tiles"});
@@ -130,13 +140,30 @@ Scene LoadSceneYaml(const std::string& path) {
     if (!targets || !targets.IsMap() || targets.size() == 0)
       reader.Fail("targets", "missing (a map of name: target spec file)");
     std::map<std::string, std::pair<std::string, std::shared_ptr<const CalibrationTarget>>> by_name;
+    std::map<std::string, BoardWarp> warps;  // a bent board: {spec: file, warp_mm: [x, y]}
     for (const auto& entry : targets) {
       const std::string name = entry.first.as<std::string>();
-      const std::string spec = reader.Resolve(entry.second.as<std::string>());
+      const std::string where = "targets." + name;
+      std::string spec_text;
+      if (entry.second.IsMap()) {
+        reader.RejectUnknown(entry.second, where, {"spec", "warp_mm"});
+        if (!entry.second["spec"]) reader.Fail(where + ".spec", "missing (the target spec file)");
+        spec_text = reader.Text(entry.second["spec"], where + ".spec");
+        if (const YAML::Node warp = entry.second["warp_mm"]) {
+          if (!warp.IsSequence() || warp.size() != 2)
+            reader.Fail(where + ".warp_mm", "must be [along x, along y]: the deflection at the centre in mm");
+          warps[name] = {reader.Number(warp[0], where + ".warp_mm[0]"), reader.Number(warp[1], where + ".warp_mm[1]")};
+          if (!(std::abs(warps[name].x_mm) <= 100.0 && std::abs(warps[name].y_mm) <= 100.0))
+            reader.Fail(where + ".warp_mm", "must be within +-100 mm");
+        }
+      } else {
+        spec_text = reader.Text(entry.second, where);
+      }
+      const std::string spec = reader.Resolve(spec_text);
       try {
         by_name[name] = {spec, std::make_shared<const CalibrationTarget>(CalibrationTarget::FromYaml(spec))};
       } catch (const InputError& error) {
-        reader.Fail("targets." + name, std::string("cannot load the target spec: ") + error.what());
+        reader.Fail(where, std::string("cannot load the target spec: ") + error.what());
       }
     }
     auto place = [&](const std::string& name, const Placement& p, const std::string& where, bool strict,
@@ -145,6 +172,7 @@ Scene LoadSceneYaml(const std::string& path) {
       placed->name = name;
       placed->spec_path = spec;
       placed->target = target;
+      placed->surface = WarpedSurface::Of(*target, warps.count(name) ? warps.at(name) : BoardWarp());
       PlaceTarget(*scene.sensor, *target, p.omega_deg, p.azimuth_deg, p.distance_mm, p.roll_deg, p.tilt_x_deg,
                   p.tilt_y_deg, &placed->camera_from_target_rotation, &placed->camera_from_target_translation_mm);
       const Eigen::Vector2d c = target->centre_mm();

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "calib/board_warp.h"
 #include "calib/target.h"
 #include "model/sensor.h"
 
@@ -35,6 +36,8 @@ struct ImageFormation {
   double noise_sigma = 0.0;    // Gaussian sensor noise, grey levels of 255
   double blur_sigma_px = 0.0;  // defocus, Gaussian
   double vignetting = 0.0;     // brightness x (1 - vignetting (r / r_rim)^2)
+  int jpeg_quality = 0;        // 0: PNG (lossless); 1-100: the images are written as JPEG of that quality
+  bool colour = false;         // 3 channels with a warm white balance (per-channel gains) and per-channel noise
   unsigned seed = 1;
 };
 
@@ -44,6 +47,7 @@ struct PlacedTarget {
   std::string spec_path;
   Eigen::Matrix3d camera_from_target_rotation;
   Eigen::Vector3d camera_from_target_translation_mm;
+  WarpedSurface surface;  // the board's bend (calib/board_warp.h); flat when its warp is zero
 };
 
 struct SceneView {

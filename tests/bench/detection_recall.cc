@@ -54,7 +54,8 @@ int main() {
     const CalibrationTarget target = CalibrationTarget::FromYaml(truth.target_spec);
     const bool tags = target.type() == CalibrationTarget::Type::kAprilGrid;
     const std::string name = std::filesystem::path(set).filename().string();
-    const std::string guess_path = name == "ohte-sph-misaligned-near"
+    // The misaligned sphere's sets (the realistic ones too) through the design guess.
+    const std::string guess_path = name == "ohte-sph-misaligned-near" || name.rfind("realistic-", 0) == 0
                                        ? source + "/datasets-synthetic/sensors/ohte-sph-misaligned-guess.yaml"
                                        : set + "/sensor.yaml";
     const Sensor guess = LoadSensorYaml(guess_path);

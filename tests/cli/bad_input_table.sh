@@ -50,6 +50,8 @@ sed "s#\\.\\./#$data/#; s/samples_per_pixel: [0-9]*/samples_per_pixel: -4/" "$da
 sed "s#\\.\\./#$data/#; s/distance_n: \[37, 43\]/distance_n: [.nan, 43]/" "$data/scenes/ohte-sph-far.yaml" >"$f/scene-nan.yaml"
 # One view, one sample per pixel: quick even under the sanitizers.
 sed "s#\.\./#$data/#; s/samples_per_pixel: [0-9]*/samples_per_pixel: 1/; s/count: 6/count: 1/" "$data/scenes/ohte-sph-far.yaml" >"$f/scene-small.yaml"
+sed "s#\.\./#$data/#; s/warp_mm: \[3, 1\]/warp_mm: [3]/" "$data/scenes/realistic-checkerboard.yaml" >"$f/scene-warp.yaml"
+sed "s#\.\./#$data/#; s/jpeg_quality: 85/jpeg_quality: 120/" "$data/scenes/realistic-checkerboard.yaml" >"$f/scene-jpeg.yaml"
 printf '{"target": "%s", "image_size": [1040, 1040], "images": [{"image": "a.png", "corners": [{"id": 1, "pixel": [1e999, 2]}]}]}' \
   "$grid" >"$f/detections-huge.json"
 printf 'x_mm,z_mm\n0,0\n1,0.1\n0.5,0.2\n2,0.3\n' >"$f/profile-back.csv"
@@ -118,6 +120,10 @@ row target "empty spec" "$o.png" error -- target --spec "$f/empty.yaml" --out "$
 row render "negative samples per pixel" "$o" error -- render --scene "$f/scene-negative.yaml" --out "$o"
 row render "NaN view distance" "$o" error -- render --scene "$f/scene-nan.yaml" --out "$o"
 row render "missing scene" "$o" error -- render --scene "$f/none.yaml" --out "$o"
+row render "board warp with one value" "$o" error -- render --scene "$f/scene-warp.yaml" --out "$o"
+row render "JPEG quality 120" "$o" error -- render --scene "$f/scene-jpeg.yaml" --out "$o"
+row diff "missing calibration" "$o" error -- diff "$f/none" "$sensor" --out "$o"
+row diff "a sensor of another image size" "$o" error -- diff "$sensor" "$data/sensors/ohte-sph-misaligned-guess.yaml" --out "$o"
 # detect / calibrate
 row detect "truncated PNG" "$o.json" error -- detect --target "$grid" --images "$f/truncated" --out "$o.json"
 row detect "non-image file named .png" "$o.json" error -- detect --target "$grid" --images "$f/notimage" --out "$o.json"
