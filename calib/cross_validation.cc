@@ -62,6 +62,11 @@ HeldOutViews EvaluateHeldOutViews(const Sensor& sensor, const CalibrationTarget&
   options.view_rms_ratio = HUGE_VAL;
   options.progress = nullptr;
   const FitResult fit = FitSensor(sensor, target, posed, poses, options);
+  if (!fit.sensor) {  // nothing fitted: no number, and why
+    for (const ImageDetections& image : posed.images)
+      held.not_evaluated[image.image] = "the poses could not be fitted: " + fit.solver_report;
+    return held;
+  }
   double square = 0.0;
   int count = 0;
   for (size_t v = 0; v < posed.images.size(); ++v) {
@@ -69,6 +74,8 @@ HeldOutViews EvaluateHeldOutViews(const Sensor& sensor, const CalibrationTarget&
     int view_count = 0;
     if (v < fit.residuals_px.size()) AddView(fit.residuals_px[v], &view_square, &view_count);
     held.per_view_rms_px[posed.images[v].image] = view_count ? std::sqrt(view_square / view_count) : NAN;
+    if (v < fit.view_left_out.size() && !fit.view_left_out[v].empty())
+      held.not_evaluated[posed.images[v].image] = "its pose could not be fitted: " + fit.view_left_out[v];
     square += view_square, count += view_count;
   }
   held.corners = count;

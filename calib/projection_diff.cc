@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "calib/bundle_fit.h"
 #include "calib/predicted_error.h"
 #include "model/input_error.h"
 
@@ -120,12 +121,15 @@ ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, 
   for (size_t i = 0; i < kept.size(); ++i) kept_points.col(i) = points.col(kept[i]), kept_pixels.col(i) = pixels[kept[i]];
 
   double angle_axis[3] = {0.0, 0.0, 0.0}, translation[3] = {0.0, 0.0, 0.0};
+  // The alignment's steps (and its central differences) move points at the rim a little
+  // past it: through a 15 % wider rim they still project (as the bundle fit's cost does).
+  const Sensor wide = SensorWithWiderRim(other, 1.15);
   Eigen::Matrix2Xd before;
-  MovedPixels(other, kept_points, angle_axis, translation, &before);
+  MovedPixels(wide, kept_points, angle_axis, translation, &before);
   diff.unaligned_rms_px = std::sqrt((before - kept_pixels).colwise().squaredNorm().mean());
   if (align) {
     ceres::Problem problem;
-    problem.AddResidualBlock(new AlignmentCost(other, kept_points, kept_pixels), nullptr, angle_axis, translation);
+    problem.AddResidualBlock(new AlignmentCost(wide, kept_points, kept_pixels), nullptr, angle_axis, translation);
     // At infinity a translation moves no point: only the rotation is determined.
     if (distance_mm >= kInfinityMm) problem.SetParameterBlockConstant(translation);
     ceres::Solver::Options options;
@@ -140,7 +144,7 @@ ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, 
     if (!diff.aligned) angle_axis[0] = angle_axis[1] = angle_axis[2] = translation[0] = translation[1] = translation[2] = 0.0;
   }
   Eigen::Matrix2Xd after;
-  if (!MovedPixels(other, kept_points, angle_axis, translation, &after)) {
+  if (!MovedPixels(wide, kept_points, angle_axis, translation, &after)) {
     // Unreachable in practice (the solver only accepts steps where every point projects).
     after = before;
     diff.aligned = false;
