@@ -8,6 +8,7 @@
 
 #include "calib/calibrate.h"
 #include "calib/calibration_json.h"
+#include "calib/calibration_summary.h"
 #include "calib/image_file.h"
 #include "calib/report/calibration_report.h"
 #include "model/io/atomic_write.h"
@@ -65,33 +66,7 @@ void Run(Options options, const Context& context) {
   WriteCalibrationJson(result.record, (dir / "calibration.json").string());
   WriteCalibrationReport((dir / "report").string(), result, library);
   PrintWarnings(result.warnings, context);
-  if (context.quiet) return;
-  if (const auto& rim = result.record.rim_circle)
-    std::printf("rim circle: centre (%.2f, %.2f) px, radius %.2f px (%.0f%% of rays, %.2f px RMS)\n", rim->centre_px.x(),
-                rim->centre_px.y(), rim->radius_px, 100.0 * rim->inlier_fraction, rim->rms_px);
-  int corners = 0;
-  for (const ImageDetections& image : result.views.images) corners += static_cast<int>(image.corners.size());
-  std::printf("%zu views, %d corners: RMS %.4f px, %s; -> %s\n", result.views.images.size(), corners, result.record.rms_px,
-              result.record.converged ? "converged" : "NOT converged", options.out_dir.c_str());
-  for (const ParameterEstimate& p : result.record.parameters) {
-    if (p.fixed) {
-      std::printf("  %-16s %14.8g (fixed)\n", p.name.c_str(), p.value);
-    } else {
-      std::printf("  %-16s %14.8g +- %.3g\n", p.name.c_str(), p.value, p.std);
-    }
-  }
-  std::printf("all fitted corners, outliers included: RMS %.4f px\n", result.record.rms_all_px);
-  if (const auto& warp = result.record.board_warp)
-    std::printf("board warp: %.3f +- %.3f mm along x, %.3f +- %.3f mm along y (deflection at the centre)\n",
-                warp->warp.x_mm, warp->std_x_mm, warp->warp.y_mm, warp->std_y_mm);
-  if (const auto& held = result.record.holdout)
-    std::printf("held out: %zu views, %d corners: RMS %.4f px (training %.4f px, ratio %.2f)\n", held->images.size(),
-                held->corners, held->rms_px, result.record.rms_all_px, held->rms_px / result.record.rms_all_px);
-  if (const auto& cross = result.record.cross_validation)
-    std::printf("two halves (RMS %.4f / %.4f px) differ at %.0f mm by %.4f px RMS, %.4f px max over %d field pixels "
-                "(after the best rigid alignment: %.3f deg, %.2f mm)\n",
-                cross->half_rms_px[0], cross->half_rms_px[1], cross->diff.distance_mm, cross->diff.rms_px,
-                cross->diff.max_px, cross->diff.compared, cross->diff.rotation_deg, cross->diff.translation_mm.norm());
+  if (!context.quiet) std::fputs(CalibrationSummaryText(result, options.out_dir).c_str(), stdout);
 }
 
 }  // namespace

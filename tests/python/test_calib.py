@@ -300,6 +300,9 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
     warp = result.board_warp
     assert close(warp["x_mm"], cli["board_warp"]["x_mm"]) and close(warp["std_y_mm"], cli["board_warp"]["std_y_mm"])
     assert omnical.calibrate(TARGET, detections=detections, guess=GUESS, max_iterations=1).board_warp is None
+    summary = result.summary()  # what the CLI prints without -q
+    assert f"RMS {result.rms_px:.4f} px" in summary and f"ratio {held['rms_px'] / result.rms_all_px:.2f}" in summary
+    assert f"{warp['x_mm']:.3f} +- {warp['std_x_mm']:.3f} mm along x" in summary and "differ at 1500 mm" in summary
 
     # diff: the full calibration against the held-out one, over the detections' annulus.
     done = run_cli("-q", "diff", runs.out / "cli", tmp_path / "cli", "--field", detections, "--distance-mm", 1500,

@@ -22,6 +22,7 @@
 
 #include "calib/calibrate.h"
 #include "calib/calibration_json.h"
+#include "calib/calibration_summary.h"
 #include "calib/fit_covariance.h"
 #include "calib/image_file.h"
 #include "calib/projection_diff.h"
@@ -645,6 +646,9 @@ are also attributes here), the warnings with their codes, the views and residual
           },
           "The predicted projection error maps (the report's figures): list of dicts (label, distance_mm, pixels "
           "(N, 2), std_px (N,), NaN where the point does not project).")
+      .def(
+          "summary", [](const PyCalibration& c) { return CalibrationSummaryText(c.result); },
+          "The lines `omnical calibrate` prints (str): RMS, parameters with stds, warp, held-out and halves.")
       .def("save", &Save, "out_dir"_a, "report"_a = true,
            "Writes what `omnical calibrate --out` writes: sensor.yaml, calibration.json, detections.json (when detected "
            "here) and, with report=True, the report figures (out_dir/report/*.png).");

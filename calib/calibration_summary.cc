@@ -1,0 +1,63 @@
+#include "calib/calibration_summary.h"
+
+#include <cstdarg>
+#include <cstdio>
+
+namespace omnical {
+namespace {
+
+// printf into a std::string: the summary keeps the CLI's fixed-width columns.
+void AppendFormatted(std::string& out, const char* format, ...) {
+  va_list args;
+  va_start(args, format);
+  va_list copy;
+  va_copy(copy, args);
+  const int size = std::vsnprintf(nullptr, 0, format, copy);
+  va_end(copy);
+  if (size > 0) {
+    std::string line(static_cast<size_t>(size) + 1, '\0');
+    std::vsnprintf(line.data(), line.size(), format, args);
+    line.pop_back();
+    out += line;
+  }
+  va_end(args);
+}
+
+}  // namespace
+
+std::string CalibrationSummaryText(const CalibrationResult& result, const std::string& destination) {
+  const CalibrationRecord& record = result.record;
+  std::string out;
+  if (const auto& rim = record.rim_circle)
+    AppendFormatted(out, "rim circle: centre (%.2f, %.2f) px, radius %.2f px (%.0f%% of rays, %.2f px RMS)\n",
+                    rim->centre_px.x(), rim->centre_px.y(), rim->radius_px, 100.0 * rim->inlier_fraction, rim->rms_px);
+  int corners = 0;
+  for (const ImageDetections& image : result.views.images) corners += static_cast<int>(image.corners.size());
+  AppendFormatted(out, "%zu views, %d corners: RMS %.4f px, %s", result.views.images.size(), corners, record.rms_px,
+                  record.converged ? "converged" : "NOT converged");
+  out += destination.empty() ? "\n" : "; -> " + destination + "\n";
+  for (const ParameterEstimate& p : record.parameters) {
+    if (p.fixed) {
+      AppendFormatted(out, "  %-16s %14.8g (fixed)\n", p.name.c_str(), p.value);
+    } else {
+      AppendFormatted(out, "  %-16s %14.8g +- %.3g\n", p.name.c_str(), p.value, p.std);
+    }
+  }
+  AppendFormatted(out, "all fitted corners, outliers included: RMS %.4f px\n", record.rms_all_px);
+  if (const auto& warp = record.board_warp)
+    AppendFormatted(out, "board warp: %.3f +- %.3f mm along x, %.3f +- %.3f mm along y (deflection at the centre)\n",
+                    warp->warp.x_mm, warp->std_x_mm, warp->warp.y_mm, warp->std_y_mm);
+  if (const auto& held = record.holdout)
+    AppendFormatted(out, "held out: %zu views, %d corners: RMS %.4f px (training %.4f px, ratio %.2f)\n",
+                    held->images.size(), held->corners, held->rms_px, record.rms_all_px, held->rms_px / record.rms_all_px);
+  if (const auto& cross = record.cross_validation)
+    AppendFormatted(out,
+                    "two halves (RMS %.4f / %.4f px) differ at %.0f mm by %.4f px RMS, %.4f px max over %d field "
+                    "pixels (after the best rigid alignment: %.3f deg, %.2f mm)\n",
+                    cross->half_rms_px[0], cross->half_rms_px[1], cross->diff.distance_mm, cross->diff.rms_px,
+                    cross->diff.max_px, cross->diff.compared, cross->diff.rotation_deg,
+                    cross->diff.translation_mm.norm());
+  return out;
+}
+
+}  // namespace omnical
