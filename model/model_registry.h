@@ -22,9 +22,9 @@
 //   EvaluateSag<S>(r^2), CheckDomain(rim), MaxRadiusMm(), Cast<U>()   the geometry
 //                             (model/mirror_profiles.h explains the s = r^2 convention)
 //   kSettings, ToSettings(v), SetSettings(v)   optional: values of the sensor file that
-//                             shape the profile but are no parameters: read and written
-//                             after rim_radius, never fitted, kept by WithParams and Cast
-//                             (ProfileSettings below)
+//                             shape the profile but are no parameters (the spline's span):
+//                             read and written after rim_radius, never fitted, kept by
+//                             WithParams and Cast (ProfileSettings below)
 // Lens<T>:
 //   kName, kFields, kNumParams, kIsOrthographic, FromParams(p), ToParams(p),
 //   ProjectToPixel, PixelToRay, MaxFocalPx, CheckDomain, Cast<U>()
@@ -42,6 +42,7 @@
 #include "model/lenses.h"
 #include "model/mirror_profiles.h"
 #include "model/parameter_field.h"
+#include "model/spline_profile.h"
 #include "model/tabulated_profile.h"
 
 namespace omnical {
@@ -52,7 +53,7 @@ template <template <typename> class... Lenses>
 struct LensList {};
 
 using RegisteredProfiles = ProfileList<SphereProfile, EvenPolynomialProfile, HyperboloidProfile, ParaboloidProfile,
-                                       TabulatedProfile, EvenAsphereProfile>;
+                                       TabulatedProfile, EvenAsphereProfile, SplineProfile>;
 using RegisteredLenses = LensList<PinholeLens, OrthographicLens>;
 
 namespace registry_detail {
