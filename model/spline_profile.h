@@ -139,6 +139,22 @@ struct SplineProfile {
     return out;
   }
 
+  // The bundle fit's smoothness prior on the knots (calib/shape_smoothness.h), one value per
+  // knot position s_j, j = 0 .. n - 1: the second difference v_j-1 - 2 v_j + v_j+1 (the
+  // phantoms included) is h^2 B''(s_j), and 4 S B'' the radial curvature z'' the knots add
+  // at the span S = span^2; as a ratio to the vertex's 2 c1 (this spline's c1: the guess's,
+  // so the prior stays quadratic), 2 S B''(s_j) / c1. Scale-free, and 0 for the paraboloid.
+  int NumSmoothnessResiduals() const { return num_knots; }
+  template <typename U>
+  void SmoothnessResiduals(const U* params, U* residuals) const {
+    const double h = SpacingMm2();
+    const double scale = 2.0 * span_mm * span_mm / (h * h * ScalarPart(c1_per_mm));
+    const SplineProfile<U> shape = WithParams<U>(params);
+    for (int j = 0; j < num_knots; ++j)
+      residuals[j] = U(scale) * (shape.template Control<U>(j - 1) - U(2.0) * shape.template Control<U>(j) +
+                                 shape.template Control<U>(j + 1));
+  }
+
   // v_j for j = -1 .. n (the two phantoms at the axis, see the top).
   template <typename S>
   S Control(int j) const {
