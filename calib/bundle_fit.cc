@@ -14,6 +14,7 @@
 #include "calib/fit_covariance.h"
 #include "calib/reprojection_cost.h"
 #include "calib/sensor_blocks.h"
+#include "calib/shape_smoothness.h"
 #include "model/ceres_progress.h"
 #include "model/input_error.h"
 
@@ -243,6 +244,10 @@ class FitRun {
       problem_.AddResidualBlock(new PriorCost(blocks_.BlockSize(block), index, centre, tolerance / scale, &prior_noise_px_),
                                 nullptr, block);
     }
+    using Profile = typename Model::ProfileType;
+    if constexpr (kHasShapeSmoothness<Profile>)
+      smoothness_ = problem_.AddResidualBlock(ShapeSmoothnessCost<Profile>::Create(guess_.mirror, &prior_noise_px_),
+                                              nullptr, blocks_.shape.data());
   }
 
   // The lens entries held throughout (by the refine switches), and in stage 1 also the
@@ -422,7 +427,7 @@ class FitRun {
   void Finish() {
     result_.sigma_px = Statistics();
     // The priors' final weight: the noise the covariance is scaled by (so the two agree).
-    if (!priors_.empty() && std::abs(result_.sigma_px - prior_noise_px_) > 0.05 * prior_noise_px_) {
+    if ((!priors_.empty() || smoothness_) && std::abs(result_.sigma_px - prior_noise_px_) > 0.05 * prior_noise_px_) {
       prior_noise_px_ = std::max(1e-6, result_.sigma_px);
       Solve();
       result_.sigma_px = Statistics();
@@ -511,6 +516,9 @@ class FitRun {
     std::vector<ceres::ResidualBlockId> data_blocks;
     for (const Residual& r : residuals_)
       if (!r.outlier) data_blocks.push_back(r.id);
+    // The smoothness prior weighs by the corner noise, as the data do: scaled by 1 / sigma
+    // with them it enters as the Gaussian prior it stands for.
+    if (smoothness_ && options_.refine.shape) data_blocks.push_back(smoothness_);
     std::vector<PriorRow> prior_rows;
     for (const Prior& prior : priors_) {
       const auto found = columns.find(prior.block);
@@ -602,6 +610,7 @@ class FitRun {
   std::vector<Residual> residuals_;
   std::vector<size_t> view_residuals_;
   std::vector<Prior> priors_;
+  ceres::ResidualBlockId smoothness_ = nullptr;  // a free-form profile's (calib/shape_smoothness.h)
   double prior_noise_px_ = 1.0;  // the corner noise the priors are scaled by; updated between solves
   ceres::Solver::Options solver_;
   ProgressReporter progress_;

@@ -21,11 +21,16 @@
 //   SolveRimSlope<U>(p, count, slope)   sets kRimSlopeParam so that f'(1) = slope
 //   EvaluateSag<S>(r^2), CheckDomain(rim), MaxRadiusMm(), Cast<U>()   the geometry
 //                             (model/mirror_profiles.h explains the s = r^2 convention)
+//   kSettings, ToSettings(v), SetSettings(v)   optional: values of the sensor file that
+//                             shape the profile but are no parameters (the spline's span):
+//                             read and written after rim_radius, never fitted, kept by
+//                             WithParams and Cast (ProfileSettings below)
 // Lens<T>:
 //   kName, kFields, kNumParams, kIsOrthographic, FromParams(p), ToParams(p),
 //   ProjectToPixel, PixelToRay, MaxFocalPx, CheckDomain, Cast<U>()
 #pragma once
 
+#include <array>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -37,6 +42,7 @@
 #include "model/lenses.h"
 #include "model/mirror_profiles.h"
 #include "model/parameter_field.h"
+#include "model/spline_profile.h"
 #include "model/tabulated_profile.h"
 
 namespace omnical {
@@ -47,7 +53,7 @@ template <template <typename> class... Lenses>
 struct LensList {};
 
 using RegisteredProfiles = ProfileList<SphereProfile, EvenPolynomialProfile, HyperboloidProfile, ParaboloidProfile,
-                                       TabulatedProfile, EvenAsphereProfile>;
+                                       TabulatedProfile, EvenAsphereProfile, SplineProfile>;
 using RegisteredLenses = LensList<PinholeLens, OrthographicLens>;
 
 namespace registry_detail {
@@ -104,6 +110,18 @@ void registry_detail::ForEachAlternative(F&& f, std::index_sequence<I...>) {
 // A profile's parameters: fitted or not, in the order of its fields.
 template <typename Profile>
 constexpr bool kFittedProfile = Profile::kMaxParams > 0;
+
+// A profile's settings (kSettings): none unless it declares them.
+template <typename Profile, typename = void>
+struct ProfileSettings {
+  static constexpr std::array<ParameterField, 0> kFields{};
+};
+template <typename Profile>
+struct ProfileSettings<Profile, std::void_t<decltype(Profile::kSettings)>> {
+  static constexpr auto kFields = Profile::kSettings;
+};
+template <typename Profile>
+constexpr bool kHasSettings = ProfileSettings<Profile>::kFields.size() > 0;
 
 // The profile names, in registry order (with_tabulated: also those the fit cannot shape).
 std::vector<std::string> ProfileNames(bool with_tabulated = true);

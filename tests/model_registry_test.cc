@@ -24,10 +24,12 @@ TEST(ModelRegistry, EveryModelTypeHasTestSensors) {
 
 TEST(ModelRegistry, NamesTheChoicesInRegistryOrder) {
   EXPECT_EQ(ProfileNames(), (std::vector<std::string>{"sphere", "polynomial", "hyperboloid", "paraboloid", "tabulated",
-                                                      "even_asphere"}));
+                                                      "even_asphere", "spline"}));
   EXPECT_EQ(ProfileNames(false),
+            (std::vector<std::string>{"sphere", "polynomial", "hyperboloid", "paraboloid", "even_asphere", "spline"}));
+  // The spline is fitted, never designed (no kRimSlopeParam).
+  EXPECT_EQ(DesignProfileNames(),
             (std::vector<std::string>{"sphere", "polynomial", "hyperboloid", "paraboloid", "even_asphere"}));
-  EXPECT_EQ(DesignProfileNames(), ProfileNames(false));
   EXPECT_EQ(LensNames(), (std::vector<std::string>{"pinhole", "orthographic"}));
   EXPECT_EQ(JoinChoices({"a", "b", "c"}), "a, b or c");
 }

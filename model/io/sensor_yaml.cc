@@ -146,9 +146,15 @@ SensorModel ReadModel(const FieldReader& reader, const YAML::Node& root) {
     m.pose = pose;
     m.rim_radius_mm = rim_mm;
     if constexpr (kFittedProfile<Profile>) {
-      reader.RejectUnknown(mirror, "mirror", Keys(Profile::kFields, {"profile", "rim_radius"}));
+      const auto& settings = ProfileSettings<Profile>::kFields;
+      reader.RejectUnknown(mirror, "mirror", Keys(settings, Keys(Profile::kFields, {"profile", "rim_radius"})));
+      const std::vector<double> setting_values = ReadFields(reader, mirror, "mirror", settings.data(), settings.size());
       const std::vector<double> shape = ReadFields(reader, mirror, "mirror", Profile::kFields.data(), Profile::kFields.size());
       m.mirror = Profile::FromParams(shape.data(), static_cast<int>(shape.size()));
+      if constexpr (kHasSettings<Profile>) m.mirror.SetSettings(setting_values.data());
+      // Reported at the field it names ("knots: ..."), as the lens's (ValidateSensorModel
+      // would repeat the check with "mirror: " only).
+      if (const std::string why = m.mirror.CheckDomain(rim_mm); !why.empty()) FailDomain(reader, "mirror", why);
     } else {
       reader.RejectUnknown(mirror, "mirror", {"profile", "rim_radius", "table"});
       std::filesystem::path table = reader.Text(mirror["table"], "mirror.table");
@@ -245,6 +251,12 @@ std::string SensorYamlText(const Sensor& sensor) {
         out << YAML::Key << "mirror" << YAML::Value << YAML::Flow << YAML::BeginMap;
         out << YAML::Key << "profile" << YAML::Value << Profile::kName;
         out << YAML::Key << "rim_radius" << YAML::Value << m.rim_radius_mm;
+        if constexpr (kHasSettings<Profile>) {
+          constexpr size_t kCount = ProfileSettings<Profile>::kFields.size();
+          double settings[kCount];
+          m.mirror.ToSettings(settings);
+          WriteFields(out, ProfileSettings<Profile>::kFields.data(), kCount, std::vector<int>(kCount, 1), settings);
+        }
         if constexpr (kFittedProfile<Profile>) {
           std::vector<double> shape(m.mirror.NumParams());
           m.mirror.ToParams(shape.data());

@@ -231,7 +231,8 @@ def test_status_enum_matches_the_files_names():
 def test_the_registrys_choices_and_the_even_asphere_of_a_catalogue(data):
     """The profile list comes from the model registry; the even asphere with the
     hyperboloid's conic constant is the shipped SVP sensor (to 1e-9 px, the C++ test's bound)."""
-    assert omnical.PROFILES == ["sphere", "polynomial", "hyperboloid", "paraboloid", "tabulated", "even_asphere"]
+    assert omnical.PROFILES == ["sphere", "polynomial", "hyperboloid", "paraboloid", "tabulated", "even_asphere",
+                                "spline"]
     assert omnical.LENSES == ["pinhole", "orthographic"]
     assert "tabulated" not in omnical.DESIGN_PROFILES and "even_asphere" in omnical.DESIGN_PROFILES
     svp = omnical.Sensor.load(data / "sensors" / "ohte-svp.yaml")
