@@ -391,9 +391,7 @@ class FitRun {
       }
     }
     const size_t fitted_views = std::count(result_.view_left_out.begin(), result_.view_left_out.end(), "");
-    const auto& r = options_.refine;
-    const bool sensor_free = r.focal || r.principal_point || r.distortion || r.m || r.tilt || r.decenter || r.shape;
-    if (fitted_views < (sensor_free ? kMinViews : 1)) {
+    if (fitted_views < (options_.refine.RefinesSensor() ? kMinViews : 1)) {
       result_.solver_report = std::to_string(fitted_views) + " views are left after the outlier rule (" +
                               std::to_string(kMinViews) + " needed): the corners do not show one board through one sensor";
       return false;

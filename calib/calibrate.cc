@@ -225,6 +225,8 @@ std::string CalibrationOptions::Check() const {
   if (!(max_predicted_error_px >= 0.0 && std::isfinite(max_predicted_error_px))) return "max_predicted_error_px: must be >= 0";
   if (!(predicted_error_step_px > 0.0 && std::isfinite(predicted_error_step_px))) return "predicted_error_step_px: must be > 0";
   if (holdout_views < 0) return "holdout_views: must be >= 0";
+  if (knots != 0 && knots != kChooseKnots && (knots < SplineProfile<double>::kMinKnots || knots > SplineProfile<double>::kMaxKnots))
+    return "knots: must be 4..16 (or auto)";
   if (!(cross_validation_distance_mm >= 0.0 && std::isfinite(cross_validation_distance_mm)))
     return "cross_validation_distance_mm: must be > 0 and finite (0: the default)";
   return "";
@@ -265,18 +267,30 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     record.start = "rim circle, " + profile + " mirror, orthographic lens";
     record.rim_circle = CalibrationRecord::RimCircleRecord{rim->centre_px, rim->radius_px, rim->inlier_fraction, rim->rms_px};
   }
+  if (options.knots != 0) {
+    const std::string profile = start_sensor->profile_name();
+    if (profile != "spline")
+      throw InputError(
+          InputMessage("knots", "", "only the spline profile has knots (profile: " + profile + "; ask for --profile spline)"));
+    if (options.knots > 0) start_sensor = ConvertProfile(*start_sensor, "spline", options.knots);
+  }
   const Sensor& guess = *start_sensor;
   if (detections.image_width_px != guess.image_width_px() || detections.image_height_px != guess.image_height_px())
     throw InputError(InputMessage(input.source, "image_size",
                                   std::to_string(detections.image_width_px) + " x " + std::to_string(detections.image_height_px) +
                                       " differs from the sensor's " + std::to_string(guess.image_width_px()) + " x " +
                                       std::to_string(guess.image_height_px())));
-  const FitOptions fit_options = FitOptionsFor(input, options, guess, &warnings);
+  FitOptions fit_options = FitOptionsFor(input, options, guess, &warnings);
 
   int unrefined = 0;
   UsableViews views = ViewsForFit(guess, input, FittableCorners(input, detections, &unrefined), &warnings);
   const std::set<std::string> holdout_names = HoldoutNames(input, views, options.holdout_views);
   UsableViews held = SplitOff(&views, holdout_names);
+  // Too few views to halve: said before the fit, not after it (the halves are of the views
+  // the fit keeps, so this is necessary, and CrossValidateHalves checks again).
+  if (const size_t half = views.detections.images.size() / 2; options.cross_validate && half < 3)
+    throw InputError("cross_validate: half 2 has " + std::to_string(half) +
+                     " views (need >= 3 per half, >= 6 usable views in all)");
   std::optional<Sensor> refit_start;  // the previous pass's fit, where the last fit started
   FitResult fit = FitSensor(guess, input.target, views.detections, views.poses, fit_options);
   // Second detection pass (aprilgrid from images): the corners are refined in patches
@@ -294,7 +308,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     held = SplitOff(&views, holdout_names);
     fit = FitSensor(*refit_start, input.target, views.detections, views.poses, fit_options);
   }
-  const Sensor& fit_start = refit_start ? *refit_start : guess;
+  Sensor fit_start = refit_start ? *refit_start : guess;
   // Boards of another size than the target (a decoy the detector accepted, e.g. a window
   // of tiles that passed the continuation test) are refused through the fitted sensor and
   // the fit is repeated without them (calib/board_scale.h).
@@ -324,6 +338,26 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
                                           " views are left once the boards of another size are refused (need >= 3)"));
       fit = FitSensor(fit_start, input.target, views.detections, views.poses, fit_options);
     }
+  }
+  // The spline's knot count by held-out folds over the views the fit kept, then the fit
+  // again with that count.
+  if (options.knots == kChooseKnots && fit.sensor) {
+    DetectionSet kept = views.detections;
+    kept.images.clear();
+    std::vector<TargetPose> kept_poses;
+    for (size_t v = 0; v < views.detections.images.size(); ++v)
+      if (fit.view_left_out[v].empty())
+        kept.images.push_back(views.detections.images[v]), kept_poses.push_back(views.poses[v]);
+    // Without a spline: the guess's family, or the polynomial the rim circle starts from.
+    const std::string guess_profile = input.guess ? input.guess->profile_name() : "";
+    const std::string base = guess_profile.empty() || guess_profile == "spline" ? "polynomial" : guess_profile;
+    record.knot_choice = ChooseKnots(fit_start, base, input.target, kept, kept_poses, fit_options, options.progress);
+    const int chosen = record.knot_choice->chosen;
+    fit_start = chosen > 0 ? ConvertProfile(fit_start, "spline", chosen) : ConvertProfile(fit_start, base);
+    record.start += chosen > 0 ? ", " + std::to_string(chosen) + " knots (chosen by held-out folds)"
+                               : "; held-out folds chose the " + base + " mirror over a spline";
+    fit_options = WithShapeOf(fit_options, fit_start);
+    fit = FitSensor(fit_start, input.target, views.detections, views.poses, fit_options);
   }
   const DetectionSet& usable = views.detections;
   if (!fit.sensor) throw InputError(InputMessage(input.source, "", "the fit failed: " + fit.solver_report));

@@ -20,6 +20,7 @@
 #include "calib/design_tolerances.h"
 #include "calib/image_detection.h"
 #include "calib/initial_sensor.h"
+#include "calib/knot_choice.h"
 #include "calib/predicted_error.h"
 #include "calib/target.h"
 #include "model/progress.h"
@@ -57,6 +58,9 @@ struct CalibrationOptions {
   int holdout_views = 0;
   // Fit the board's out-of-plane warp (calib/board_warp.h) with the sensor.
   bool board_warp = false;
+  // A spline mirror's knot count (model/spline_profile.h): 0 keeps the guess's (6 when
+  // converted), 4..16, or kChooseKnots: chosen by held-out folds (calib/knot_choice.h).
+  int knots = 0;
   bool cross_validate = false;
   double cross_validation_distance_mm = 0.0;
   DesignTolerances tolerances;  // added to / overriding the guess's

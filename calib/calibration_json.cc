@@ -25,6 +25,11 @@ const char* const kHoldoutDefinition =
 const char* const kBoardWarpDefinition =
     "the board's out-of-plane shape z = x_mm (1 - u^2) + y_mm (1 - v^2) along its normal, u, v the corner's position "
     "scaled to [-1, 1] over the board's corners: the deflections at the centre relative to the edges (mm)";
+const char* const kKnotChoiceDefinition =
+    "the spline mirror's knot count chosen by held-out folds: the fitted views split into `folds` interleaved folds, "
+    "each held out in turn while the rest are calibrated with every candidate count; candidate 0 is base_profile (no spline); held_out_rms_px over every "
+    "held-out corner of every fold (poses fitted, sensor held), per corner sqrt(mean |e|^2); chosen: the fewest "
+    "knots (0 first) within 1 % of the lowest";
 const char* const kCrossValidationDefinition =
     "the usable views split into even and odd positions, each half calibrated alone; the points distance_mm along "
     "each observed field pixel's ray through half 1 (from its reflection point), moved by the rigid motion that "
@@ -74,6 +79,17 @@ json ToJson(const CalibrationRecord& r) {
   if (const auto& w = r.board_warp)
     j["board_warp"] = {{"x_mm", w->warp.x_mm}, {"y_mm", w->warp.y_mm}, {"std_x_mm", NumberOrNull(w->std_x_mm)},
                        {"std_y_mm", NumberOrNull(w->std_y_mm)}, {"definition", kBoardWarpDefinition}};
+  if (const auto& k = r.knot_choice) {
+    json& out = j["knot_choice"];
+    out["base_profile"] = k->base_profile;
+    out["candidates"] = k->candidates;
+    out["held_out_rms_px"] = json::array();
+    for (double rms : k->held_out_rms_px) out["held_out_rms_px"].push_back(NumberOrNull(rms));
+    out["held_out_corners"] = k->held_out_corners;
+    out["folds"] = k->folds;
+    out["chosen"] = k->chosen;
+    out["definition"] = kKnotChoiceDefinition;
+  }
   if (const auto& h = r.holdout) {
     json& out = j["holdout"];
     out["views"] = h->images;
@@ -177,6 +193,19 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
       const json& w = at("board_warp");
       r.board_warp = BoardWarpEstimate{{w.at("x_mm").get<double>(), w.at("y_mm").get<double>()},
                                        NumberOrNan(w.at("std_x_mm")), NumberOrNan(w.at("std_y_mm"))};
+    }
+    if (j.contains("knot_choice")) {
+      const json& k = at("knot_choice");
+      KnotChoice choice;
+      choice.base_profile = k.at("base_profile").get<std::string>();
+      choice.candidates = k.at("candidates").get<std::vector<int>>();
+      for (const json& rms : k.at("held_out_rms_px")) choice.held_out_rms_px.push_back(NumberOrNan(rms));
+      choice.held_out_corners = k.at("held_out_corners").get<int>();
+      choice.folds = k.at("folds").get<int>();
+      choice.chosen = k.at("chosen").get<int>();
+      if (choice.held_out_rms_px.size() != choice.candidates.size())
+        throw InputError(InputMessage(name, "knot_choice.held_out_rms_px", "must have one value per candidate"));
+      r.knot_choice = choice;
     }
     if (j.contains("holdout")) {
       const json& h = at("holdout");

@@ -16,6 +16,7 @@
 #include "calib/bundle_fit.h"
 #include "calib/cross_validation.h"
 #include "calib/design_tolerances.h"
+#include "calib/knot_choice.h"
 
 namespace omnical {
 
@@ -43,6 +44,7 @@ struct CalibrationRecord {
   // holdout_views); the training RMS to compare with is rms_all_px / rms_px.
   std::optional<HeldOutViews> holdout;
   std::optional<BoardWarpEstimate> board_warp;  // when fitted (CalibrationOptions::board_warp)
+  std::optional<KnotChoice> knot_choice;  // when chosen (CalibrationOptions::knots = kChooseKnots)
   // The two halves' calibrations compared (CalibrationOptions::cross_validate). The diff's
   // per-pixel vectors are kept in memory for the report's figure; the file has the summary.
   struct CrossValidationRecord {

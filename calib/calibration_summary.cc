@@ -47,6 +47,15 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
   if (const auto& warp = record.board_warp)
     AppendFormatted(out, "board warp: %.3f +- %.3f mm along x, %.3f +- %.3f mm along y (deflection at the centre)\n",
                     warp->warp.x_mm, warp->std_x_mm, warp->warp.y_mm, warp->std_y_mm);
+  if (const auto& knots = record.knot_choice) {
+    out += "knots chosen by " + std::to_string(knots->folds) + " held-out folds (" +
+           std::to_string(knots->held_out_corners) + " corners):";
+    for (size_t k = 0; k < knots->candidates.size(); ++k)
+      AppendFormatted(out, " %s: %.4f px%s",
+                      knots->candidates[k] > 0 ? std::to_string(knots->candidates[k]).c_str() : knots->base_profile.c_str(),
+                      knots->held_out_rms_px[k], knots->candidates[k] == knots->chosen ? " (chosen)" : "");
+    out += "\n";
+  }
   if (const auto& held = record.holdout)
     AppendFormatted(out, "held out: %zu views, %d corners: RMS %.4f px (training %.4f px, ratio %.2f)\n",
                     held->images.size(), held->corners, held->rms_px, record.rms_all_px, held->rms_px / record.rms_all_px);

@@ -51,10 +51,7 @@ HeldOutViews EvaluateHeldOutViews(const Sensor& sensor, const CalibrationTarget&
     poses.push_back(pose);
   }
   if (posed.images.empty()) return held;
-  RefineOptions poses_only;
-  poses_only.focal = poses_only.principal_point = poses_only.distortion = false;
-  poses_only.m = poses_only.tilt = poses_only.decenter = poses_only.shape = false;
-  options.refine = poses_only;
+  options.refine = RefineOptions::PosesOnly();
   options.tolerances.clear();
   options.design.clear();
   options.compute_covariance = false;

@@ -67,6 +67,19 @@ std::set<std::string> RefineOptions::HeldNames() const {
   return names;
 }
 
+bool RefineOptions::RefinesSensor() const {
+  for (const RefineSwitch& s : kSwitches)
+    if (s.is_group && this->*s.member) return true;
+  return false;
+}
+
+RefineOptions RefineOptions::PosesOnly() {
+  RefineOptions only;
+  for (const RefineSwitch& s : kSwitches)
+    if (s.is_group) only.*s.member = false;
+  return only;
+}
+
 ceres::Solver::Options DefaultSolverOptions() {
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_QR;

@@ -35,6 +35,10 @@ struct RefineOptions {
   std::string Hold(const std::set<std::string>& names);
   // The held blocks by those names (lens for focal + principal point + distortion).
   std::set<std::string> HeldNames() const;
+  // Whether any sensor block is free (everything but the poses).
+  bool RefinesSensor() const;
+  // Every sensor block held, the poses free: views evaluated through a fitted sensor.
+  static RefineOptions PosesOnly();
 };
 
 // The block name that holds a group (--fix, Python's fixed=, RefineOptions::Hold).

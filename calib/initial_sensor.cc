@@ -67,6 +67,21 @@ SensorModel WithMirror(const Model& model, Target out, const typename Target::Pr
   return out;
 }
 
+template <typename Profile, typename = void>
+constexpr bool kHasKnots = false;
+template <typename Profile>
+constexpr bool kHasKnots<Profile, std::void_t<decltype(Profile::kMaxKnots)>> = true;
+
+int NumKnots(const Sensor& sensor) {
+  return std::visit(
+      [](const auto& model) {
+        using Profile = std::decay_t<decltype(model.mirror)>;
+        if constexpr (kHasKnots<Profile>) return model.mirror.num_knots;
+        return 0;
+      },
+      sensor.model());
+}
+
 Sensor Validated(SensorModel model, const std::string& what) {
   const std::string problem = ValidateSensorModel(model);
   if (!problem.empty()) throw InputError(InputMessage(what, "profile", "the starting sensor is not valid: " + problem));
@@ -117,8 +132,10 @@ Sensor SensorFromRimCircle(const RimCircle& rim, int image_width_px, int image_h
                                                      JoinChoices(startable) + "; a hyperboloid needs a guess with its design)"));
 }
 
-Sensor ConvertProfile(const Sensor& guess, const std::string& profile) {
-  if (profile == guess.profile_name()) return guess;
+Sensor ConvertProfile(const Sensor& guess, const std::string& profile, int knots) {
+  if (knots > 0 && profile != "spline")
+    throw InputError(InputMessage("knots", "", "only the spline profile has knots (profile: " + profile + ")"));
+  if (profile == guess.profile_name() && (knots <= 0 || NumKnots(guess) == knots)) return guess;
   const std::vector<std::string> fitted = ProfileNames(false);
   if (std::find(fitted.begin(), fitted.end(), profile) == fitted.end())
     throw InputError(InputMessage("profile", "", "unknown profile '" + profile + "' (" + JoinChoices(fitted) + ")"));
@@ -145,7 +162,9 @@ Sensor ConvertProfile(const Sensor& guess, const std::string& profile) {
           using Model = std::decay_t<decltype(model)>;
           if constexpr (kFittedProfile<Profile> && std::is_same_v<typename Target::LensType, typename Model::LensType>) {
             if (converted || profile != Profile::kName) return;
-            const Profile start = Profile::FromVertexRadius(vertex_radius, rim);
+            Profile start = Profile::FromVertexRadius(vertex_radius, rim);
+            if constexpr (kHasKnots<Profile>)
+              if (knots > 0) start.num_knots = knots;  // FromVertexRadius's knots are all 0
             converted = Validated(WithMirror(model, Target{}, FitProfile(samples, r2s, rim, start)), "guess");
           }
         });

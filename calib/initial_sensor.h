@@ -29,8 +29,10 @@ constexpr int kDefaultPolynomialCoefficients = 3;
 Sensor SensorFromRimCircle(const RimCircle& rim, int image_width_px, int image_height_px, const std::string& profile,
                            double rim_field_deg = kDefaultRimFieldDeg);
 
-// profile: sphere, paraboloid, polynomial or hyperboloid; the guess itself if it already
+// profile: any the fit can shape (ProfileNames(false)); the guess itself if it already
 // has that profile. Throws InputError if the result is not a valid sensor.
-Sensor ConvertProfile(const Sensor& guess, const std::string& profile);
+// knots > 0: a spline with that many knots (model/spline_profile.h; converted again if
+// the guess is a spline with another count); InputError naming `knots` for another profile.
+Sensor ConvertProfile(const Sensor& guess, const std::string& profile, int knots = 0);
 
 }  // namespace omnical

@@ -9,6 +9,8 @@
 
 #include "calib/board_warp.h"
 #include "calib/bundle_fit.h"
+#include "calib/initial_sensor.h"
+#include "calib/knot_choice.h"
 #include "calib/synthetic/renderer.h"
 #include "test_sensors.h"
 #include "model/io/sensor_yaml.h"
@@ -313,6 +315,14 @@ TEST(RefineOptions, HoldsBlocksByTheirNamesAndRejectsUnknownOnes) {
   refine = RefineOptions();
   EXPECT_EQ(refine.Hold({"principal_point", "distortion"}), "");
   EXPECT_EQ(refine.HeldNames(), (std::set<std::string>{"distortion", "principal_point"}));
+  EXPECT_TRUE(refine.RefinesSensor());
+  const RefineOptions poses = RefineOptions::PosesOnly();
+  EXPECT_FALSE(poses.RefinesSensor());
+  EXPECT_TRUE(poses.poses);
+  EXPECT_EQ(poses.HeldNames(), (std::set<std::string>{"lens", "m", "tilt", "decenter", "shape"}));
+  refine = RefineOptions();
+  EXPECT_EQ(refine.Hold({"lens", "m", "tilt", "decenter"}), "");
+  EXPECT_TRUE(refine.RefinesSensor());  // the shape is still free
 }
 
 TEST(FitOptions, CheckRefusesInvalidSolverSettings) {
@@ -323,6 +333,53 @@ TEST(FitOptions, CheckRefusesInvalidSolverSettings) {
   options = FitOptions();
   options.solver.function_tolerance = -1.0;
   EXPECT_EQ(options.Check().rfind("solver: ", 0), 0u) << options.Check();
+}
+
+// The spline's knot count by held-out folds (calib/knot_choice.h), on corners with 0.1 px
+// of noise per coordinate (0.141 px per corner): the mirror of BumpedSplineProfile (a
+// 0.3 mm figure error in 6 knots) is one the 3-term polynomial cannot follow, so a spline
+// must be chosen and predict the held-out views at the noise; a polynomial mirror needs
+// no spline (the parsimony rule keeps it unless a spline predicts 1 % better). Both start
+// from the truth converted to the polynomial, as a guess of the wrong family would be.
+TEST(KnotChoice, ChoosesASplineOnlyWhereTheMirrorNeedsOne) {
+  const double kNoisePerCornerPx = 0.1 * std::sqrt(2.0);
+  for (const testing::NamedSensor& named : testing::SensorsWithLens<OrthographicLens>("orthographic", false)) {
+    const bool bumped = named.name.rfind("spline", 0) == 0;
+    if (!bumped && named.name.rfind("polynomial", 0) != 0) continue;
+    SCOPED_TRACE(named.name);
+    Truth truth = MixedDistanceObservations(Sensor(named.model));
+    truth.detections.images.resize(10);  // 10 views, 5 folds of 2: a real set's size
+    std::mt19937 rng(5);
+    std::normal_distribution<double> noise(0.0, 0.1);
+    for (ImageDetections& image : truth.detections.images) {
+      std::vector<CornerObservation> every_third;  // 48 of a view's 144 corners: the test's time
+      for (size_t c = 0; c < image.corners.size(); c += 3) every_third.push_back(image.corners[c]);
+      image.corners = every_third;
+      for (CornerObservation& corner : image.corners) corner.pixel += Eigen::Vector2d(noise(rng), noise(rng));
+    }
+    const Sensor start = ConvertProfile(truth.sensor, "polynomial");
+    std::vector<TargetPose> poses(truth.detections.images.size());
+    for (size_t v = 0; v < poses.size(); ++v)
+      ASSERT_TRUE(InitialTargetPose(start, truth.target, truth.detections.images[v], &poses[v])) << v;
+    const KnotChoice choice = ChooseKnots(start, "polynomial", truth.target, truth.detections, poses, FitOptions());
+    ASSERT_EQ(choice.candidates, kKnotCandidates);
+    EXPECT_EQ(choice.folds, 5);
+    double chosen_rms = NAN;
+    std::string scores;
+    for (size_t k = 0; k < choice.candidates.size(); ++k) {
+      if (choice.candidates[k] == choice.chosen) chosen_rms = choice.held_out_rms_px[k];
+      scores += " " + std::to_string(choice.candidates[k]) + ": " + std::to_string(choice.held_out_rms_px[k]);
+    }
+    SCOPED_TRACE("held-out RMS by knots (0: polynomial):" + scores);
+    // Held out at the noise: 25 % above it allows for the poses fitted to 2 views per fold.
+    EXPECT_LT(chosen_rms, 1.25 * kNoisePerCornerPx);
+    if (bumped) {
+      EXPECT_GT(choice.chosen, 0);
+      EXPECT_GT(choice.held_out_rms_px[0], 2.0 * chosen_rms) << "the polynomial should miss the figure error";
+    } else {
+      EXPECT_EQ(choice.chosen, 0) << "a spline chosen for a polynomial mirror";
+    }
+  }
 }
 
 }  // namespace

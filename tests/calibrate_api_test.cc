@@ -108,6 +108,14 @@ TEST(CalibrateApi, RecordRoundTripsThroughCalibrationJson) {
   EXPECT_EQ((back.covariance - result.record.covariance).cwiseAbs().maxCoeff(), 0.0);
   ASSERT_EQ(back.predicted_error.size(), 1u);
   EXPECT_EQ(back.predicted_error[0].max_px, result.record.predicted_error[0].max_px);
+  // A knot choice (its numbers set here: choosing takes 30 fits) with a failed candidate.
+  CalibrationRecord chosen = result.record;
+  chosen.knot_choice = KnotChoice{"polynomial", kKnotCandidates, {0.31, 0.3, NAN, 0.33, 0.34, 0.5}, 384, 5, 4};
+  const CalibrationRecord chosen_back = ParseCalibrationJson(CalibrationJsonText(chosen), "memory");
+  ASSERT_TRUE(chosen_back.knot_choice.has_value());
+  EXPECT_EQ(chosen_back.knot_choice->chosen, 4);
+  EXPECT_TRUE(std::isnan(chosen_back.knot_choice->held_out_rms_px[2]));
+  EXPECT_EQ(CalibrationJsonText(chosen_back), CalibrationJsonText(chosen));
 }
 
 // A view whose corners are all wrong is left out: its RMS is written as null and must read
@@ -151,6 +159,22 @@ TEST(CalibrateApi, BadOptionsAndInputsNameTheField) {
   } catch (const InputError& error) {
     EXPECT_EQ(std::string(error.what()).rfind("tolerances: ", 0), 0u) << error.what();
   }
+  // Knots: only for a spline, 4..16 or auto.
+  options = {};
+  options.knots = kChooseKnots;
+  try {
+    Calibrate(InputFromTruth(), options);
+    FAIL() << "knots accepted for a sphere";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()), "knots: only the spline profile has knots (profile: sphere; ask for --profile spline)");
+  }
+  options.profile = "spline";
+  options.knots = 17;
+  EXPECT_EQ(options.Check(), "knots: must be 4..16 (or auto)");
+  EXPECT_EQ(ParseKnotCount("auto", "knots"), kChooseKnots);
+  EXPECT_EQ(ParseKnotCount("12", "knots"), 12);
+  EXPECT_THROW(ParseKnotCount("12x", "knots"), InputError);
+  EXPECT_THROW(ParseKnotCount("", "knots"), InputError);
 }
 
 TEST(CalibrateApi, CallbackReturningFalseCancels) {

@@ -21,7 +21,7 @@ namespace omnical::cli {
 namespace {
 
 struct Options {
-  std::string target_path, detections_path, images, sensor_path, out_dir, fix, tolerance;
+  std::string target_path, detections_path, images, sensor_path, out_dir, fix, tolerance, knots;
   CalibrationOptions library;
 };
 
@@ -31,7 +31,7 @@ const FlagTable kFlags = {{"fixed", "--fix"}, {"robust_loss_px", "--loss-px"}, {
                           {"detection_passes", "--detection-passes"}, {"distances_mm", "--distance-mm"},
                           {"distances_n", "--distance-n"}, {"max_predicted_error_px", "--max-predicted-error-px"},
                           {"holdout_views", "--holdout"}, {"holdout", "--holdout"}, {"cross_validate", "--cross-validate"},
-                          {"cross_validation_distance_mm", "--cross-validate-distance-mm"}};
+                          {"cross_validation_distance_mm", "--cross-validate-distance-mm"}, {"knots", "--knots"}};
 
 void Run(Options options, const Context& context) {
   CalibrationInput input;
@@ -56,6 +56,7 @@ void Run(Options options, const Context& context) {
   for (std::string block; std::getline(fix, block, ',');)
     if (!block.empty()) library.fixed.insert(block);
   library.tolerances = ParseDesignTolerances(options.tolerance, "--tolerance");
+  if (!options.knots.empty()) library.knots = ParseKnotCount(options.knots, "--knots");
   library.progress = TerminalProgress(context);
   const CalibrationResult result = NamingFlags(kFlags, [&] { return Calibrate(input, library); });
 
@@ -122,6 +123,9 @@ Command CalibrateCommand() {
             sub.add_flag("--board-warp", library.board_warp,
                          "Also fit the board's out-of-plane warp (a paraboloid along each board axis, mm at the centre; "
                          "paper boards bend)");
+            sub.add_option("--knots", options->knots,
+                           "With --profile spline: the mirror's knot count (4..16), or auto: chosen by held-out "
+                           "folds of the views (calibration.json knot_choice)");
             sub.add_flag("--cross-validate", library.cross_validate,
                          "Also calibrate each half of the views (even / odd) and report how far the two disagree over "
                          "the observed field after the best rigid alignment (report/cross_validation.png)");

@@ -46,10 +46,11 @@ void Run(const Options& options, const Context& context) {
   if (!options.out_dir.empty()) {
     const std::filesystem::path dir(options.out_dir);
     CreateOutputDirectory(dir);
-    WriteProjectionDiffJson(diff, {{"a", SensorFileOf(options.a)}, {"b", SensorFileOf(options.b)}, {"field", field_label}},
-                            (dir / "diff.json").string());
+    // The figure first: a figure that cannot be written leaves no diff.json to mistake for a run.
     WriteProjectionDiffFigure((dir / "diff.png").string(), diff, a.image_width_px(), a.image_height_px(),
                               "b: " + SensorFileOf(options.b) + " against a: " + SensorFileOf(options.a));
+    WriteProjectionDiffJson(diff, {{"a", SensorFileOf(options.a)}, {"b", SensorFileOf(options.b)}, {"field", field_label}},
+                            (dir / "diff.json").string());
   }
   if (context.quiet) return;
   std::printf("at %.0f mm over %d pixels (%s): RMS %.4f px, median %.4f px, max %.4f px\n", options.distance_mm,

@@ -277,6 +277,12 @@ calibrate_error calibrate_holdout_too_many "holdout: 6 views held out of 8 usabl
   --target "$grid" --detections "$work/det.json" --holdout 6
 calibrate_error calibrate_halves_too_small "--cross-validate: half 2 has 2 views (need >= 3 per half" \
   --target "$grid" --detections "$work/det.json" --holdout 3 --cross-validate
+calibrate_error calibrate_knots_range "--knots: must be 4..16 (or auto)" --target "$grid" --detections "$work/det.json" \
+  --profile spline --knots 3
+calibrate_error calibrate_knots_text "--knots: expected a knot count (4..16) or 'auto', got 'six'" --target "$grid" \
+  --detections "$work/det.json" --profile spline --knots six
+calibrate_error calibrate_knots_not_spline "only the spline profile has knots (profile: sphere; ask for --profile spline)" \
+  --target "$grid" --detections "$work/det.json" --knots auto
 calibrate_error calibrate_one_pose "all views show the target at one pose" --target "$grid" --detections "$work/det_same.json"
 calibrate_error calibrate_spec_matches_nothing "matches no corner id" --target "$work/other_ids.yaml" --detections "$work/det.json"
 calibrate_error calibrate_image_size "image_size: 1000 x 1000 differs from the sensor's 1040 x 1040" --target "$grid" --detections "$work/det_size.json"

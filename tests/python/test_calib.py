@@ -317,6 +317,18 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
     same = omnical.diff(result.sensor, result.sensor, distance_mm=1500)
     assert same["rms_px"] < 1e-7 and same["compared"] > 100
 
+    # A spline mirror with a set knot count; bad counts with the CLI's message.
+    spline = omnical.calibrate(TARGET, detections=detections, guess=GUESS, profile="spline", knots=4,
+                               max_iterations=20)
+    assert "knot4" in spline.parameters and "knot5" not in spline.parameters and spline.knot_choice is None
+    bad_knots = cli_error(run_cli("calibrate", "--target", TARGET, "--detections", detections, "--sensor", GUESS,
+                                  "--profile", "spline", "--knots", "six", "--out", tmp_path / "bad"))
+    with pytest.raises(omnical.InputError) as raised:
+        omnical.calibrate(TARGET, detections=detections, guess=GUESS, profile="spline", knots="six")
+    assert str(raised.value) == bad_knots.replace("--knots", "knots")
+    with pytest.raises(omnical.InputError, match="knots: expected a knot count"):
+        omnical.calibrate(TARGET, detections=detections, guess=GUESS, profile="spline", knots=True)
+
     # Bad values: the CLI's message with the kwarg's name.
     few_views = cli_error(run_cli("calibrate", "--target", TARGET, "--detections", detections, "--sensor", GUESS,
                                   "--holdout", 40, "--out", tmp_path / "bad"))

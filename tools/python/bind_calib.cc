@@ -246,6 +246,16 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
       "The board's fitted warp (board_warp=True): dict x_mm, y_mm (deflection at the centre along each board axis) "
       "and their std_x_mm, std_y_mm; None unless fitted.");
   cls.def_property_readonly(
+      "knot_choice",
+      [record](const Holder& holder) -> py::object {
+        const auto& k = record(holder).knot_choice;
+        if (!k) return py::none();
+        return py::dict("base_profile"_a = k->base_profile, "candidates"_a = k->candidates, "held_out_rms_px"_a = k->held_out_rms_px,
+                        "held_out_corners"_a = k->held_out_corners, "folds"_a = k->folds, "chosen"_a = k->chosen);
+      },
+      "The spline's knot count chosen by held-out folds (knots='auto'): dict base_profile, candidates (0: base_profile, no spline), held_out_rms_px (per "
+      "candidate), held_out_corners, folds, chosen; None unless chosen.");
+  cls.def_property_readonly(
       "holdout",
       [record](const Holder& holder) -> py::object {
         const CalibrationRecord& r = record(holder);
@@ -345,7 +355,7 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
                         const py::object& tolerances, const std::vector<double>& distances_mm,
                         const std::vector<double>& distances_n, double max_predicted_error_px, double rim_field_deg,
                         int holdout, bool cross_validate, double cross_validation_distance_mm, bool board_warp,
-                        py::object progress) {
+                        const py::object& knots, py::object progress) {
   CalibrationInput input;
   PyTarget target = TargetOf(target_arg);
   input.target = std::move(target.board);
@@ -384,6 +394,13 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
   options.rim_field_deg = rim_field_deg;
   options.holdout_views = holdout;
   options.board_warp = board_warp;
+  if (py::isinstance<py::str>(knots)) {
+    options.knots = ParseKnotCount(knots.cast<std::string>(), "knots");
+  } else if (py::isinstance<py::int_>(knots) && !py::isinstance<py::bool_>(knots)) {
+    options.knots = knots.cast<int>();
+  } else {
+    throw InputError("knots: expected a knot count (4..16) or 'auto', got " + TypeName(knots));
+  }
   options.cross_validate = cross_validate;
   options.cross_validation_distance_mm = cross_validation_distance_mm;
   options.progress = ForwardProgress(std::move(progress));
@@ -659,7 +676,7 @@ are also attributes here), the warnings with their codes, the views and residual
         "distances_mm"_a = std::vector<double>(), "distances_n"_a = std::vector<double>(),
         "max_predicted_error_px"_a = 0.3, "rim_field_deg"_a = kDefaultRimFieldDeg, "holdout"_a = 0,
         "cross_validate"_a = false, "cross_validation_distance_mm"_a = 0.0, "board_warp"_a = false,
-        "progress"_a = py::none(),
+        "knots"_a = 0, "progress"_a = py::none(),
         R"(Calibrates the sensor (as `omnical calibrate`) -> CalibrationResult.
 
 target: a Target or a spec path. Corners: images (as detect(): a directory or glob, a
@@ -677,7 +694,9 @@ max_predicted_error_px: warn above it. holdout: K views (spread evenly) kept out
 fit and evaluated with the sensor held (result.holdout). cross_validate: each half of the
 views calibrated and compared at cross_validation_distance_mm (0: the first distance
 asked, else 2000) after the best rigid alignment (result.cross_validation). board_warp:
-also fit the board's out-of-plane warp (result.board_warp, mm).
+also fit the board's out-of-plane warp (result.board_warp, mm). knots: the spline
+mirror's knot count (profile='spline'): 0 the guess's (6 converted), 4..16, or 'auto' to
+choose it by held-out folds (result.knot_choice).
 progress(stage, done, total): False cancels.
 Raises InputError with the library's message (too few views, a bad file, a bad value).)");
 

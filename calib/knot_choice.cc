@@ -1,0 +1,107 @@
+#include "calib/knot_choice.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <map>
+
+#include "calib/cross_validation.h"
+#include "calib/initial_sensor.h"
+#include "model/input_error.h"
+
+namespace omnical {
+
+int ParseKnotCount(const std::string& text, const std::string& field) {
+  if (text == "auto") return kChooseKnots;
+  size_t used = 0;
+  int count = 0;
+  try {
+    count = std::stoi(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || count < 1)
+    throw InputError(field + ": expected a knot count (4..16) or 'auto', got '" + text + "'");
+  return count;
+}
+
+FitOptions WithShapeOf(FitOptions options, const Sensor& candidate) {
+  if (options.design.empty()) return options;  // no priors to centre
+  std::map<std::string, double> design;
+  for (const ParameterEstimate& p : SensorParameters(candidate)) {
+    const auto found = options.design.find(p.name);
+    const bool knot = p.name.rfind("knot", 0) == 0;
+    design[p.name] = knot || found == options.design.end() ? p.value : found->second;
+  }
+  options.design = std::move(design);
+  return options;
+}
+
+KnotChoice ChooseKnots(const Sensor& start, const std::string& base_profile, const CalibrationTarget& target,
+                       const DetectionSet& views,
+                       const std::vector<TargetPose>& initial_poses, FitOptions options, const ProgressCallback& progress) {
+  if (base_profile == "spline") throw InputError("knots: the base family to compare the spline with cannot be a spline");
+  const int count = static_cast<int>(views.images.size());
+  if (count < 4)
+    throw InputError("knots: choosing the count needs >= 4 usable views (held-out folds leave >= 3 to fit); " +
+                     std::to_string(count) + " given");
+  KnotChoice choice;
+  choice.base_profile = base_profile;
+  choice.candidates = kKnotCandidates;
+  // Five folds where the views allow: each training set keeps 4/5 of the views, close to
+  // the full fit the choice is for.
+  choice.folds = std::min(5, count);
+  options.compute_covariance = false;
+  options.progress = nullptr;
+  ProgressReporter reporter(progress, "knots", static_cast<int>(choice.candidates.size()) * choice.folds);
+  for (int knots : choice.candidates) {
+    const Sensor candidate = knots > 0 ? ConvertProfile(start, "spline", knots) : ConvertProfile(start, base_profile);
+    double square = 0.0;
+    int corners = 0;
+    bool failed = false;
+    for (int fold = 0; fold < choice.folds && !failed; ++fold) {
+      DetectionSet training = views, held = views;
+      training.images.clear(), held.images.clear();
+      std::vector<TargetPose> poses;
+      for (int v = 0; v < count; ++v) {
+        if (v % choice.folds == fold) {
+          held.images.push_back(views.images[v]);
+        } else {
+          training.images.push_back(views.images[v]);
+          poses.push_back(initial_poses[v]);
+        }
+      }
+      const FitResult fit = FitSensor(candidate, target, training, poses, WithShapeOf(options, candidate));
+      reporter.Step();
+      if (!fit.sensor) {
+        failed = true;
+        continue;
+      }
+      FitOptions held_options = WithShapeOf(options, candidate);
+      if (fit.board_warp) held_options.board_warp = fit.board_warp->warp;
+      const HeldOutViews result = EvaluateHeldOutViews(*fit.sensor, target, held, held_options);
+      // A view whose pose cannot be fitted through this sensor counts against the count
+      // as failing: its corners are not in the score, so a score without them would flatter.
+      if (!result.not_evaluated.empty() || !(result.corners > 0)) {
+        failed = true;
+        continue;
+      }
+      square += result.rms_px * result.rms_px * result.corners;
+      corners += result.corners;
+    }
+    choice.held_out_rms_px.push_back(failed ? NAN : std::sqrt(square / corners));
+    if (!failed) choice.held_out_corners = corners;
+  }
+  double best = HUGE_VAL;
+  for (double rms : choice.held_out_rms_px)
+    if (std::isfinite(rms)) best = std::min(best, rms);
+  if (!std::isfinite(best)) throw InputError("knots: no knot count could be fitted to every fold of the views");
+  for (size_t k = 0; k < choice.candidates.size(); ++k)
+    if (choice.held_out_rms_px[k] <= best * (1.0 + kKnotScoreTolerance)) {
+      choice.chosen = choice.candidates[k];
+      break;
+    }
+  return choice;
+}
+
+}  // namespace omnical
