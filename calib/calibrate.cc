@@ -65,7 +65,15 @@ UsableViews ViewsForFit(const Sensor& start, const CalibrationInput& input, cons
   for (const ImageDetections& image : detections.images) {
     TargetPose pose;
     if (image.corners.size() < 4 || !InitialTargetPose(start, input.target, image, &pose)) {
-      warnings->push_back({WarningCode::kViewSkipped, image.image, image.image + ": too few usable corners, view skipped"});
+      const std::string count = std::to_string(image.corners.size());
+      const std::string why =
+          !image.corners.empty() ? (image.corners.size() < 4 ? "only " + count + " usable corners"
+                                                             : "no starting pose from its " + count + " usable corners")
+          : input.target.type() == CalibrationTarget::Type::kCheckerboard
+              ? "no complete checkerboard of " + std::to_string(input.target.cols()) + " x " +
+                    std::to_string(input.target.rows()) + " inner corners found"
+              : "no tag of the target found";
+      warnings->push_back({WarningCode::kViewSkipped, image.image, image.image + ": " + why + ", view skipped"});
       continue;
     }
     views.detections.images.push_back(image);
@@ -134,16 +142,44 @@ std::optional<RimCircle> RimOfImages(const DetectionSet& detections) {
 
 // The corners, detected here (with the rim circles when there is no guess) or given.
 DetectedImages FindCorners(const CalibrationInput& input, const CalibrationOptions& options,
-                           const std::optional<Sensor>& through, bool rim_circles) {
+                           const std::optional<Sensor>& through, bool rim_circles, bool omni_search = true) {
   DetectionOptions detection;
   detection.guess = through;
   detection.rim_circles = rim_circles;
   detection.threads = options.threads;
   detection.progress = options.progress;
+  detection.omni_search = omni_search;
   DetectedImages found = input.image_paths.empty() ? DetectImages(input.target, input.images, detection)
                                                    : DetectImageFiles(input.target, input.image_paths, input.source, detection);
   found.detections.target_spec = input.target_name;
   return found;
+}
+
+// Checkerboards the first search missed (an image without one: a board curved near the
+// rim or the inner radius), searched for through virtual views of a fitted sensor only;
+// true when one was found (it replaces the empty entry).
+bool FindMissedCheckerboards(const CalibrationInput& input, const CalibrationOptions& options, const Sensor& through,
+                             DetectionSet* detections) {
+  std::set<std::string> missed;
+  for (const ImageDetections& image : detections->images)
+    if (image.corners.empty()) missed.insert(image.image);
+  if (missed.empty()) return false;
+  CalibrationInput again = input;
+  again.image_paths.clear();
+  again.images.clear();
+  for (const std::string& path : input.image_paths)
+    if (missed.count(path)) again.image_paths.push_back(path);
+  for (const NamedImage& image : input.images)
+    if (missed.count(image.name)) again.images.push_back(image);
+  const DetectionSet found = FindCorners(again, options, through, false, /*omni_search=*/false).detections;
+  bool any = false;
+  for (const ImageDetections& image : found.images) {
+    if (image.corners.empty()) continue;
+    for (ImageDetections& entry : detections->images)
+      if (entry.image == image.image) entry = image;
+    any = true;
+  }
+  return any;
 }
 
 // The fit's tolerances: the guess's (those that apply to the fitted family), then the
@@ -293,17 +329,25 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
                      " views (need >= 3 per half, >= 6 usable views in all)");
   std::optional<Sensor> refit_start;  // the previous pass's fit, where the last fit started
   FitResult fit = FitSensor(guess, input.target, views.detections, views.poses, fit_options);
-  // Second detection pass (aprilgrid from images): the corners are refined in patches
+  // Second detection pass, from images. Aprilgrids: the corners are refined in patches
   // through a sensor, and a tag's straight edges are straight there only as far as that
   // sensor is right. Through the design guess the patch edges bend, and the corners
   // carried a radius-dependent bias the mirror's size absorbed; re-detected through the
   // first fit they do not (30-view render: A 6 std off after one pass, 0.5 std after two;
-  // tests/cli/calibrate_render_test.sh).
-  const bool redetect = from_images && input.target.type() == CalibrationTarget::Type::kAprilGrid;
-  for (int pass = 2; redetect && pass <= options.detection_passes && fit.sensor; ++pass) {
+  // tests/cli/calibrate_render_test.sh). Checkerboards: the images where none was found
+  // are searched again through the fit's virtual views (calib/detect.h); a pass that
+  // finds no more ends them.
+  const bool checkerboard = input.target.type() == CalibrationTarget::Type::kCheckerboard;
+  int passes_run = 1;
+  for (int pass = 2; from_images && pass <= options.detection_passes && fit.sensor; ++pass) {
+    if (checkerboard && !FindMissedCheckerboards(input, options, *fit.sensor, &detections)) break;
     refit_start = *fit.sensor;
-    DetectedImages found = FindCorners(input, options, refit_start, false);
-    detections = std::move(found.detections);
+    passes_run = pass;
+    if (!checkerboard) detections = FindCorners(input, options, refit_start, false).detections;
+    // The skipped views are named again by this pass's ViewsForFit.
+    warnings.erase(std::remove_if(warnings.begin(), warnings.end(),
+                                  [](const CalibrationWarning& w) { return w.code == WarningCode::kViewSkipped; }),
+                   warnings.end());
     views = ViewsForFit(*refit_start, input, FittableCorners(input, detections, &unrefined), &warnings);
     held = SplitOff(&views, holdout_names);
     fit = FitSensor(*refit_start, input.target, views.detections, views.poses, fit_options);
@@ -375,7 +419,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   record.fixed_blocks = fit_options.refine.HeldNames();
   record.robust_loss_px = fit_options.robust_loss_px;
   record.covariance_ok = fit.covariance_ok;
-  record.detection_passes = refit_start ? options.detection_passes : 1;
+  record.detection_passes = passes_run;
   if (options.leave_one_out) record.leave_one_out = LeaveOneOut(fit_start, input, views, fit_options, options.progress);
   if (!why_invalid.empty())
     warnings.push_back({WarningCode::kSensorInvalid, "", "the fitted sensor fails validation: " + why_invalid});

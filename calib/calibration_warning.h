@@ -11,7 +11,7 @@ enum class WarningCode {
   kImageUnreadable,           // subject: the image; skipped
   kImageSizeDiffers,          // subject: the image; skipped
   kCheckerboardRefused,       // subject: the image; a checkerboard-like grid that is not the target
-  kViewSkipped,               // subject: the image; too few usable corners for a starting pose
+  kViewSkipped,               // subject: the image; no target found, or too few usable corners for a starting pose
   kToleranceNotApplicable,    // subject: the parameter; the guess's tolerance does not fit the family
   kViewLeftOut,               // subject: the image; left out of the fit (why in the text)
   kSensorInvalid,             // the fitted sensor fails validation

@@ -1,6 +1,7 @@
 #include "calib/detect.h"
 
 #include "calib/bilinear.h"
+#include "calib/partial_checkerboard.h"
 #include "calib/virtual_view.h"
 
 #include <Eigen/Geometry>
@@ -13,7 +14,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <map>
+#include <optional>
+#include <utility>
 #include <stdexcept>
 
 namespace omnical {
@@ -70,28 +74,173 @@ std::map<int, std::array<Eigen::Vector2d, 4>> DetectTags(const CalibrationTarget
 bool CheckerboardTurnedAround(const CalibrationTarget& target, const cv::Mat& grey,
                               const std::vector<CornerObservation>& corners) {
   const int cols = target.cols(), rows = target.rows();
-  if (static_cast<int>(corners.size()) != cols * rows || cols < 2 || rows < 2) return false;
-  auto at = [&](int row, int col) { return corners[row * cols + col].pixel; };
+  if (corners.empty() || cols < 2 || rows < 2) return false;
+  std::map<std::pair<int, int>, Eigen::Vector2d> at;  // (row, col) -> pixel; a partial board has gaps
+  for (const CornerObservation& c : corners) at[{c.id / cols, c.id % cols}] = c.pixel;
   if ((cols + rows) % 2 == 1) {
-    const Eigen::Vector2d origin = at(0, 0), along_x = at(0, 1) - origin, along_y = at(1, 0) - origin;
-    auto square = [&](double sx, double sy) {  // mean of a few samples inside the square
-      double sum = 0.0;
-      int count = 0;
-      for (double f : {0.3, 0.5}) {
-        const Eigen::Vector2d p = origin + f * (sx * along_x + sy * along_y);
-        const double value = Bilinear<uchar>(grey, p.x(), p.y());
-        if (std::isfinite(value)) sum += value, ++count;
-      }
-      return count ? sum / count : NAN;
-    };
-    const double diagonal = square(-1, -1) + square(1, 1), other = square(1, -1) + square(-1, 1);
-    if (std::isfinite(diagonal) && std::isfinite(other)) return diagonal > other;
+    // At corner (r, c) the squares on the (-x, -y) / (+x, +y) diagonal are dark when r + c
+    // is even (corner 0's are), light when odd; the first corner with both neighbours decides.
+    for (const auto& [index, origin] : at) {
+      const auto next_col = at.find({index.first, index.second + 1}), next_row = at.find({index.first + 1, index.second});
+      if (next_col == at.end() || next_row == at.end()) continue;
+      const Eigen::Vector2d along_x = next_col->second - origin, along_y = next_row->second - origin;
+      auto square = [&](double sx, double sy) {  // mean of a few samples inside the square
+        double sum = 0.0;
+        int count = 0;
+        for (double f : {0.3, 0.5}) {
+          const Eigen::Vector2d p = origin + f * (sx * along_x + sy * along_y);
+          const double value = Bilinear<uchar>(grey, p.x(), p.y());
+          if (std::isfinite(value)) sum += value, ++count;
+        }
+        return count ? sum / count : NAN;
+      };
+      const double diagonal = square(-1, -1) + square(1, 1), other = square(1, -1) + square(-1, 1);
+      if (std::isfinite(diagonal) && std::isfinite(other))
+        return (diagonal > other) == ((index.first + index.second) % 2 == 0);
+      break;
+    }
   }
+  // Up: along each column from its lowest corner seen to its highest.
   Eigen::Vector2d centre = Eigen::Vector2d::Zero(), up = Eigen::Vector2d::Zero();
   for (const CornerObservation& c : corners) centre += c.pixel / corners.size();
-  for (int col = 0; col < cols; ++col) up += at(rows - 1, col) - at(0, col);
+  for (int col = 0; col < cols; ++col) {
+    const Eigen::Vector2d* lowest = nullptr;
+    const Eigen::Vector2d* highest = nullptr;
+    for (int row = 0; row < rows; ++row)
+      if (const auto it = at.find({row, col}); it != at.end()) {
+        if (!lowest) lowest = &it->second;
+        highest = &it->second;
+      }
+    if (lowest) up += *highest - *lowest;
+  }
   const Eigen::Vector2d image_centre(0.5 * (grey.cols - 1), 0.5 * (grey.rows - 1));
   return up.dot(centre - image_centre) < 0.0;
+}
+
+// A found board's corners (row_down, col: findChessboardCornersSB's order in an image of
+// normal handedness, the flipped omni image or a virtual view; omni pixels) with the
+// board's ids, rows counted upwards, and the 180 deg turn resolved on the omni image.
+std::vector<CornerObservation> CheckerboardCorners(const CalibrationTarget& target, const cv::Mat& omni_grey,
+                                                   const std::vector<BoardCorner>& found) {
+  std::vector<CornerObservation> corners;
+  for (const BoardCorner& c : found) corners.push_back({(target.rows() - 1 - c.row_down) * target.cols() + c.col, c.pixel});
+  auto by_id = [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; };
+  std::sort(corners.begin(), corners.end(), by_id);
+  if (CheckerboardTurnedAround(target, omni_grey, corners))
+    for (CornerObservation& c : corners) c.id = target.cols() * target.rows() - 1 - c.id;
+  std::sort(corners.begin(), corners.end(), by_id);
+  return corners;
+}
+
+// A complete grid (row-major, rows downwards) as board corners.
+std::vector<BoardCorner> BoardCorners(const std::vector<Eigen::Vector2d>& grid_px, int cols) {
+  std::vector<BoardCorner> corners;
+  for (int i = 0; i < static_cast<int>(grid_px.size()); ++i) corners.push_back({i / cols, i % cols, grid_px[i]});
+  return corners;
+}
+
+// The omni image's angular scale near the middle of the field (px per rad), roughly: a
+// quarter of the image per radian.
+double OmniPxPerRad(const Sensor& guess) {
+  return 0.5 * std::min(guess.image_width_px(), guess.image_height_px()) / 2.0;
+}
+
+// A virtual view of size_px square looking along a camera-frame direction from the
+// guess's reference viewpoint on the axis, image "down" towards the mirror's -z.
+VirtualView ViewAlong(const Sensor& guess, const Eigen::Vector3d& forward_in_camera, int size_px, double focal_px) {
+  const ProjectionCache& cache = guess.cache();
+  const double viewpoint_z = cache.guess.valid() ? cache.guess.reference_viewpoint_mm() : 0.0;
+  const Eigen::Vector3d centre = cache.camera_from_mirror_rotation * Eigen::Vector3d(0, 0, viewpoint_z) +
+                                 cache.camera_from_mirror_translation;
+  const Eigen::Vector3d down = cache.camera_from_mirror_rotation * -Eigen::Vector3d::UnitZ();
+  return VirtualView(guess, ViewFrame(forward_in_camera, down), centre, focal_px, size_px, size_px);
+}
+
+// A sweep of views looking outwards along (Omega, azimuth) of the mirror frame, Omega
+// 40-140 deg from its -z (a proper rotation: no mirror reversal), neighbours
+// step_fraction of a view's half field apart. visit(view) returns false to stop.
+void SweepVirtualViews(const Sensor& guess, int size_px, double focal_px, double step_fraction,
+                       const std::function<bool(const VirtualView&)>& visit) {
+  const Eigen::Matrix3d& mirror_to_camera = guess.cache().camera_from_mirror_rotation;
+  const double half_fov = std::atan(0.5 * size_px / focal_px);
+  for (double omega = 40.0; omega <= 140.0; omega += step_fraction * half_fov * 180.0 / M_PI) {
+    const double omega_rad = omega * M_PI / 180.0;
+    const double step = step_fraction * half_fov / std::max(0.2, std::sin(omega_rad));
+    for (double azimuth = 0.0; azimuth < 2.0 * M_PI - 1e-9; azimuth += 2.0 * M_PI / std::ceil(2.0 * M_PI / step)) {
+      const Eigen::Vector3d forward_m(std::sin(omega_rad) * std::cos(azimuth), std::sin(omega_rad) * std::sin(azimuth),
+                                      -std::cos(omega_rad));
+      if (!visit(ViewAlong(guess, mirror_to_camera * forward_m, size_px, focal_px))) return;
+    }
+  }
+}
+
+// The board, or a part of it, in a view (calib/partial_checkerboard.h), its corners in
+// omni pixels, and the direction of its centre (camera frame). A corner whose X-junction
+// (0.4 of a grid step around it) leaves the mirror's image is dropped: there its position
+// is the rim's, not the board's.
+std::optional<PartialCheckerboard> CheckerboardInView(const CalibrationTarget& target, const cv::Mat& grey,
+                                                      const VirtualView& virtual_view, Eigen::Vector3d* direction) {
+  const cv::Mat view = virtual_view.Resample(grey, cv::INTER_LINEAR);
+  std::optional<PartialCheckerboard> found = FindPartialCheckerboard(view, cv::Size(target.cols(), target.rows()));
+  if (!found) return std::nullopt;
+  *direction = Eigen::Vector3d::Zero();
+  std::vector<BoardCorner> omni;
+  for (const BoardCorner& corner : found->corners) {
+    *direction += virtual_view.Direction(corner.pixel);
+    double step_px = HUGE_VAL;
+    for (const BoardCorner& other : found->corners)
+      if (&other != &corner) step_px = std::min(step_px, (other.pixel - corner.pixel).norm());
+    BoardCorner mapped = corner;
+    bool inside = virtual_view.ToOmni(corner.pixel, &mapped.pixel);
+    Eigen::Vector2d unused;
+    for (const Eigen::Vector2d& offset : {Eigen::Vector2d(1, 1), Eigen::Vector2d(1, -1), Eigen::Vector2d(-1, 1), Eigen::Vector2d(-1, -1)})
+      inside = inside && virtual_view.ToOmni(corner.pixel + 0.7 * step_px / std::sqrt(2.0) * offset, &unused);
+    if (inside) omni.push_back(mapped);
+  }
+  direction->normalize();
+  // A junction squeezed under kMinOmniStepPx between grid neighbours in the omni image
+  // (the sphere's rim compresses the radial direction) is a blur of JPEG blocks there: its
+  // corner is not located to a pixel (a render's corners at 498-515 px from the centre of
+  // a 520 px disc: 4-5 px off). Such corners are dropped.
+  constexpr double kMinOmniStepPx = 3.0;
+  std::vector<BoardCorner> kept;
+  for (const BoardCorner& corner : omni) {
+    double nearest_px = HUGE_VAL;
+    for (const BoardCorner& other : omni)
+      if (std::abs(other.row_down - corner.row_down) + std::abs(other.col - corner.col) == 1)
+        nearest_px = std::min(nearest_px, (other.pixel - corner.pixel).norm());
+    if (nearest_px >= kMinOmniStepPx) kept.push_back(corner);
+  }
+  found->corners = std::move(kept);
+  return found;
+}
+
+// A board the omni image's search missed (strongly curved near the rim or the inner
+// radius, or cut by the rim), searched in wide views (90 deg, about the omni image's own
+// scale at their centre) where it is nearly straight. A board found there, or a part cut
+// by a view's edge, is searched again in a wider view (116 deg) aimed at its centre, where
+// it is whole and least stretched; a placed board from either is kept, the one with more
+// corners.
+ImageDetections CheckerboardThroughVirtualViews(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& guess,
+                                               const ImageDetections& raw) {
+  const int size_px = static_cast<int>(std::lround(2.5 * OmniPxPerRad(guess)));
+  const double focal_px = 0.5 * size_px;  // 90 deg across
+  std::vector<BoardCorner> best;
+  SweepVirtualViews(guess, size_px, focal_px, 1.0, [&](const VirtualView& view) {
+    Eigen::Vector3d direction;
+    const std::optional<PartialCheckerboard> found = CheckerboardInView(target, grey, view, &direction);
+    if (!found) return true;
+    if (found->placed) best = found->corners;
+    Eigen::Vector3d aimed_direction;
+    const std::optional<PartialCheckerboard> aimed = CheckerboardInView(
+        target, grey, ViewAlong(guess, direction, static_cast<int>(1.6 * size_px), focal_px), &aimed_direction);
+    if (aimed && aimed->placed && aimed->corners.size() >= best.size()) best = aimed->corners;
+    return best.empty();
+  });
+  ImageDetections out;
+  out.image = raw.image;
+  if (!best.empty()) out.corners = CheckerboardCorners(target, grey, best);
+  return out;
 }
 
 }  // namespace
@@ -125,68 +274,39 @@ ImageDetections DetectCheckerboard(const CalibrationTarget& target, const cv::Ma
   for (const CheckerboardCandidate& candidate : found)
     if (candidate.accepted && (!best || candidate.contrast > best->contrast)) best = &candidate;
   ImageDetections image;
-  if (best) {
-    // findChessboardCornersSB's order on the flipped image: row-major, rows downwards.
-    for (int i = 0; i < static_cast<int>(best->grid.corners_px.size()); ++i) {
-      const int row_down = i / target.cols(), col = i % target.cols();
-      const int id = (target.rows() - 1 - row_down) * target.cols() + col;  // rows counted upwards
-      image.corners.push_back({id, best->grid.corners_px[i]});
-    }
-    std::sort(image.corners.begin(), image.corners.end(),
-              [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; });
-    if (CheckerboardTurnedAround(target, grey, image.corners))
-      for (CornerObservation& c : image.corners) c.id = target.cols() * target.rows() - 1 - c.id;
-    std::sort(image.corners.begin(), image.corners.end(),
-              [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; });
-  }
+  if (best) image.corners = CheckerboardCorners(target, grey, BoardCorners(best->grid.corners_px, target.cols()));
   if (candidates) *candidates = std::move(found);
   return image;
 }
 
-
 ImageDetections DetectThroughVirtualViews(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& guess,
                                           const ImageDetections& raw) {
+  if (target.type() == CalibrationTarget::Type::kCheckerboard)
+    return raw.corners.empty() ? CheckerboardThroughVirtualViews(target, grey, guess, raw) : raw;
   constexpr int kSize = 400;
-  const ProjectionCache& cache = guess.cache();
-  // Reference viewpoint on the axis and the omni image's angular scale (px per rad near
-  // the middle of the field), from the guess's axial analysis.
-  const double viewpoint_z = cache.guess.valid() ? cache.guess.reference_viewpoint_mm() : 0.0;
-  const Eigen::Vector3d centre = cache.camera_from_mirror_rotation * Eigen::Vector3d(0, 0, viewpoint_z) +
-                                 cache.camera_from_mirror_translation;
-  const double omni_px_per_rad = 0.5 * std::min(guess.image_width_px(), guess.image_height_px()) / 2.0;
-  const double focal = 2.0 * omni_px_per_rad;  // magnify ~2x
-  const double half_fov = std::atan(0.5 * kSize / focal);
+  const double focal = 2.0 * OmniPxPerRad(guess);  // magnify ~2x
   struct Best {
     std::array<Eigen::Vector2d, 4> corners;
     double off_centre;
   };
   std::map<int, Best> best;
-  for (double omega = 40.0; omega <= 140.0; omega += 1.6 * half_fov * 180.0 / M_PI) {
-    const double omega_rad = omega * M_PI / 180.0;
-    const double step = 1.6 * half_fov / std::max(0.2, std::sin(omega_rad));
-    for (double azimuth = 0.0; azimuth < 2.0 * M_PI - 1e-9; azimuth += 2.0 * M_PI / std::ceil(2.0 * M_PI / step)) {
-      // The view looks outwards along (Omega, azimuth) of the mirror frame, image y down
-      // towards the mirror's -z (a proper rotation: no mirror reversal).
-      const Eigen::Vector3d forward_m(std::sin(omega_rad) * std::cos(azimuth), std::sin(omega_rad) * std::sin(azimuth),
-                                      -std::cos(omega_rad));
-      const VirtualView virtual_view(guess, cache.camera_from_mirror_rotation * ViewFrame(forward_m, -Eigen::Vector3d::UnitZ()),
-                                     centre, focal, kSize, kSize);
-      const cv::Mat view = virtual_view.Resample(grey, cv::INTER_LINEAR);
-      for (const auto& [id, corners] : DetectTags(target, view, nullptr)) {
-        std::array<Eigen::Vector2d, 4> omni;
-        bool inside = true;
-        Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-        for (int k = 0; k < 4; ++k) {
-          inside = inside && virtual_view.ToOmni(corners[k], &omni[k]);
-          mean += corners[k] / 4.0;
-        }
-        if (!inside) continue;
-        const double off_centre = (mean - Eigen::Vector2d::Constant(0.5 * (kSize - 1))).norm();
-        const auto it = best.find(id);
-        if (it == best.end() || off_centre < it->second.off_centre) best[id] = {omni, off_centre};
+  SweepVirtualViews(guess, kSize, focal, 1.6, [&](const VirtualView& virtual_view) {
+    const cv::Mat view = virtual_view.Resample(grey, cv::INTER_LINEAR);
+    for (const auto& [id, corners] : DetectTags(target, view, nullptr)) {
+      std::array<Eigen::Vector2d, 4> omni;
+      bool inside = true;
+      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+      for (int k = 0; k < 4; ++k) {
+        inside = inside && virtual_view.ToOmni(corners[k], &omni[k]);
+        mean += corners[k] / 4.0;
       }
+      if (!inside) continue;
+      const double off_centre = (mean - Eigen::Vector2d::Constant(0.5 * (kSize - 1))).norm();
+      const auto it = best.find(id);
+      if (it == best.end() || off_centre < it->second.off_centre) best[id] = {omni, off_centre};
     }
-  }
+    return true;
+  });
   ImageDetections out;
   std::map<int, std::array<Eigen::Vector2d, 4>> merged;
   for (size_t k = 0; k + 3 < raw.corners.size(); k += 4)

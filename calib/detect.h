@@ -51,12 +51,16 @@ ImageDetections DetectCheckerboard(const CalibrationTarget& target, const cv::Ma
 // Either, by the target's type.
 ImageDetections DetectTarget(const CalibrationTarget& target, const cv::Mat& grey);
 
-// AprilTag grids through virtual perspective views built with a sensor guess: a sweep of
-// pinhole views (magnified ~2x, from the mirror's reference viewpoint) resampled from the
-// omni image with maps of exact projections; tags are detected there (no mirror reversal
-// in a perspective view) and their corners mapped back through the same maps, so the
-// guess's error does not move them. Per tag, the view where it is most central wins;
-// tags found only in the omni image are kept from `raw`.
+// The target through virtual perspective views built with a sensor guess, resampled from
+// the omni image with maps of exact projections, so that what is found there maps back
+// through the same maps and the guess's error does not move it.
+// AprilTag grids: a sweep of pinhole views (magnified ~2x, from the mirror's reference
+// viewpoint); tags are detected there (no mirror reversal in a perspective view). Per tag,
+// the view where it is most central wins; tags found only in the omni image are kept from
+// `raw`.
+// Checkerboards, only when `raw` has none (all or none per image): a sweep of wide views
+// (90 deg) where a board curved near the rim or the inner radius is nearly straight, then
+// a view aimed at the board found; ids as in DetectCheckerboard. `raw` otherwise.
 ImageDetections DetectThroughVirtualViews(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& guess,
                                           const ImageDetections& raw);
 

@@ -30,20 +30,20 @@ void DetectOne(const CalibrationTarget& target, const cv::Mat& grey, const Detec
   }
   out->size = grey.size();
   const bool checkerboard = target.type() == CalibrationTarget::Type::kCheckerboard;
-  if (checkerboard) {
-    std::vector<CheckerboardCandidate> candidates;
-    out->found = DetectCheckerboard(target, grey, &candidates);
-    for (const CheckerboardCandidate& c : candidates)
-      if (!c.accepted) out->refusals.push_back(c.refusal);
-  } else {
-    out->found = DetectTarget(target, grey);
-  }
   const Sensor* guess = options.guess && grey.cols == options.guess->image_width_px() &&
                                 grey.rows == options.guess->image_height_px()
                             ? &*options.guess
                             : nullptr;
-  if (guess && target.type() == CalibrationTarget::Type::kAprilGrid)
-    out->found = DetectThroughVirtualViews(target, grey, *guess, out->found);
+  const bool omni_search = options.omni_search || !guess;
+  if (omni_search && checkerboard) {
+    std::vector<CheckerboardCandidate> candidates;
+    out->found = DetectCheckerboard(target, grey, &candidates);
+    for (const CheckerboardCandidate& c : candidates)
+      if (!c.accepted) out->refusals.push_back(c.refusal);
+  } else if (omni_search) {
+    out->found = DetectTarget(target, grey);
+  }
+  if (guess) out->found = DetectThroughVirtualViews(target, grey, *guess, out->found);
   if (checkerboard ? options.refine_checkerboards : options.refine)
     out->found = RefineCorners(target, grey, guess, out->found);
   if (options.rim_circles) out->circle = DetectRimCircle(grey);

@@ -20,10 +20,13 @@
 namespace omnical {
 
 struct DetectionOptions {
-  std::optional<Sensor> guess;        // aprilgrid: virtual views and patch refinement through it
+  std::optional<Sensor> guess;        // virtual views (calib/detect.h) and patch refinement through it
   bool refine = true;                 // aprilgrid corners (calib/refine_corners.h)
   bool refine_checkerboards = false;  // see calib/refine_corners.h: better on renders, worse on real images
   bool rim_circles = false;
+  // false: with a guess, search its virtual views only (images the omni image's search
+  // already missed: a second pass through a fitted sensor).
+  bool omni_search = true;
   int threads = 1;
   ProgressCallback progress;  // stage "detect", one step per image
   std::string Check() const;  // "" or "field: problem"

@@ -42,6 +42,12 @@ Eigen::Vector2d VirtualView::ToView(const Eigen::Vector3d& direction_in_camera) 
                          focal_px_ * in_view.y() / in_view.z() + 0.5 * (height_px() - 1));
 }
 
+Eigen::Vector3d VirtualView::Direction(const Eigen::Vector2d& view_px) const {
+  const Eigen::Vector3d in_view((view_px.x() - 0.5 * (width_px() - 1)) / focal_px_,
+                                (view_px.y() - 0.5 * (height_px() - 1)) / focal_px_, 1.0);
+  return (view_to_camera_ * in_view).normalized();
+}
+
 bool VirtualView::ToOmni(const Eigen::Vector2d& view_px, Eigen::Vector2d* omni_px) const {
   const double x = view_px.x(), y = view_px.y();
   const double u = Bilinear<float>(map_x_, x, y), v = Bilinear<float>(map_y_, x, y);

@@ -29,6 +29,8 @@ class VirtualView {
   cv::Mat Resample(const cv::Mat& omni_grey, int interpolation) const;
   // View pixel of a direction from the view's centre (pixel-centre coordinates).
   Eigen::Vector2d ToView(const Eigen::Vector3d& direction_in_camera) const;
+  // Direction (unit, camera frame) from the view's centre through a view pixel.
+  Eigen::Vector3d Direction(const Eigen::Vector2d& view_px) const;
   // Omni pixel of a view pixel, bilinear in the table; false outside the view or next to
   // a ray that missed.
   bool ToOmni(const Eigen::Vector2d& view_px, Eigen::Vector2d* omni_px) const;

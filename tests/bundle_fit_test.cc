@@ -4,6 +4,7 @@
 // RMS < 1e-6 px. This isolates the optimiser (and the Jet derivatives it runs on).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -11,6 +12,8 @@
 #include "calib/bundle_fit.h"
 #include "calib/initial_sensor.h"
 #include "calib/knot_choice.h"
+#include "calib/predicted_error.h"
+#include "calib/projection_diff.h"
 #include "calib/synthetic/renderer.h"
 #include "test_sensors.h"
 #include "model/io/sensor_yaml.h"
@@ -343,6 +346,10 @@ TEST(FitOptions, CheckRefusesInvalidSolverSettings) {
 // from the truth converted to the polynomial, as a guess of the wrong family would be.
 TEST(KnotChoice, ChoosesASplineOnlyWhereTheMirrorNeedsOne) {
   const double kNoisePerCornerPx = 0.1 * std::sqrt(2.0);
+  const std::array<double, 3> kDistancesRimRadii = {2.0, 7.0, HUGE_VAL};
+  std::array<double, 3> spline_vs_truth_rms_px, polynomial_vs_truth_rms_px;
+  spline_vs_truth_rms_px.fill(NAN);
+  polynomial_vs_truth_rms_px.fill(NAN);
   for (const testing::NamedSensor& named : testing::SensorsWithLens<OrthographicLens>("orthographic", false)) {
     const bool bumped = named.name.rfind("spline", 0) == 0;
     if (!bumped && named.name.rfind("polynomial", 0) != 0) continue;
@@ -379,7 +386,33 @@ TEST(KnotChoice, ChoosesASplineOnlyWhereTheMirrorNeedsOne) {
     } else {
       EXPECT_EQ(choice.chosen, 0) << "a spline chosen for a polynomial mirror";
     }
+    // The chosen model fitted to all 10 views against the true mirror over the observed field,
+    // after the best rigid alignment (m is a gauge of the orthographic lens), as omnical diff
+    // compares two calibrations.
+    const Sensor chosen_start = bumped ? ConvertProfile(start, "spline", choice.chosen) : start;
+    const FitResult fit = FitSensor(chosen_start, truth.target, truth.detections, poses, FitOptions());
+    ASSERT_TRUE(fit.sensor.has_value()) << fit.solver_report;
+    const std::vector<Eigen::Vector2d> field = ComparisonField(truth.sensor, &truth.detections, 24.0);
+    for (size_t d = 0; d < kDistancesRimRadii.size(); ++d) {
+      const double n = kDistancesRimRadii[d];
+      const double distance_mm = std::isfinite(n) ? n * testing::kRimMm : kInfinityMm;
+      const ProjectionDiff diff = CompareProjections(truth.sensor, *fit.sensor, field, distance_mm);
+      EXPECT_GT(diff.compared, 100);
+      (bumped ? spline_vs_truth_rms_px : polynomial_vs_truth_rms_px)[d] = diff.rms_px;
+      // The 0.1 px, as RMS over the field, where the boards are (2 to 13 rim radii).
+      if (std::isfinite(n)) {
+        EXPECT_LT(diff.rms_px, 0.1) << "n = " << n << ", max " << diff.max_px << " px";
+      }
+    }
   }
+  // Infinity is 0.19 px off for the spline and 0.47 px for the polynomial fitted to its own
+  // mirror (measured): an extrapolation the 0.14 px noise and boards <= 13 radii away limit,
+  // not the profile. So the bound there, and a check at every distance, is relative: the
+  // flexible profile on a mirror no formula fits predicts as well as the exact formula on its
+  // own mirror, from the same views and noise (ratios measured 0.91, 0.64, 0.40; 1.25 allows
+  // for the noise draw).
+  for (size_t d = 0; d < kDistancesRimRadii.size(); ++d)
+    EXPECT_LT(spline_vs_truth_rms_px[d], 1.25 * polynomial_vs_truth_rms_px[d]) << "n = " << kDistancesRimRadii[d];
 }
 
 }  // namespace

@@ -6,15 +6,18 @@
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <set>
 
 #include "calib/checkerboard_candidates.h"
 #include "calib/detect.h"
+#include "calib/partial_checkerboard.h"
 #include "calib/synthetic/ground_truth.h"
 #include "calib/refine_corners.h"
 #include "calib/synthetic/renderer.h"
@@ -96,6 +99,58 @@ TEST(DetectThroughVirtualViews, FindsFarTagsTheRawDetectorMisses) {
   EXPECT_GT(found, raw_found);
   EXPECT_GE(found, 0.97 * visible);
   EXPECT_LT(std::sqrt(sum / found), 0.2);
+}
+
+// Checkerboards the omni image's search misses: the four of the realistic set (JPEG 85,
+// blur, noise, warped paper), two by the rim (one cut by it), two strongly curved. They are
+// found in wide virtual views through the design guess (the set's truth is tilted 0.8 deg
+// and decentred 0.8 mm from it), partial boards grown corner by corner and placed when they
+// span the board. Measured: 38/42, 47/48, 48/48, 40/48 corners, all missing ones within
+// 20 px of the 520 px disc's rim (their junctions squeezed into a few JPEG-blurred pixels:
+// dropped, not guessed); RMS 0.13 px, worst 1.16 px. Bounds: >= 80 % of each board's
+// visible corners and 90 % of all; RMS < 0.3 px and none over 1.5 px (the renders' noise
+// and blur put detector corners ~0.1-0.3 px off; a corner of the wrong grid is a square
+// away, >= 8 px). Matched by position: this board's ids hold up to its 180 deg symmetry, as
+// in docs/detection-recall.md (the numbering is NumbersTheCornersAsThePrintedBoard's).
+TEST(DetectThroughVirtualViews, FindsCheckerboardsTheOmniSearchMissesByTheRimAndCurved) {
+  const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/realistic-checkerboard";
+  const DetectionSet truth =
+      DetectionsFromGroundTruth({set + "/rim0.json", set + "/rim1.json", set + "/real005.json", set + "/real007.json"});
+  const CalibrationTarget target = CalibrationTarget::FromYaml(truth.target_spec);
+  const Sensor guess = LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-sph-misaligned-guess.yaml");
+  int visible = 0, found = 0;
+  double square_sum = 0.0, worst = 0.0;
+  for (const ImageDetections& view : truth.images) {
+    SCOPED_TRACE(view.image);
+    const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(grey.empty());
+    const ImageDetections raw = DetectTarget(target, grey);
+    EXPECT_TRUE(raw.corners.empty()) << "the omni search finds this board now: pick a harder view";
+    const ImageDetections through = DetectThroughVirtualViews(target, grey, guess, raw);
+    std::set<int> matched;
+    for (const CornerObservation& c : through.corners) {
+      double nearest = HUGE_VAL;
+      int nearest_id = -1;
+      for (const CornerObservation& t : view.corners)
+        if ((c.pixel - t.pixel).norm() < nearest) nearest = (c.pixel - t.pixel).norm(), nearest_id = t.id;
+      EXPECT_TRUE(matched.insert(nearest_id).second) << "two corners on one";
+      worst = std::max(worst, nearest);
+      square_sum += nearest * nearest;
+    }
+    EXPECT_GE(through.corners.size(), 0.8 * view.corners.size());
+    visible += static_cast<int>(view.corners.size());
+    found += static_cast<int>(through.corners.size());
+    // A board found in the omni image is kept as it is.
+    ImageDetections one;
+    one.corners.push_back({0, Eigen::Vector2d(1, 2)});
+    EXPECT_EQ(DetectThroughVirtualViews(target, grey, guess, one).corners.size(), 1u);
+  }
+  const double rms = std::sqrt(square_sum / std::max(1, found));
+  RecordProperty("recall", std::to_string(static_cast<double>(found) / visible));
+  RecordProperty("rms_px", std::to_string(rms));
+  EXPECT_GE(found, 0.9 * visible);
+  EXPECT_LT(rms, 0.3);
+  EXPECT_LT(worst, 1.5);
 }
 
 // RMS pixel error of detections against a view's ground truth (by id), and how many matched;
@@ -411,6 +466,85 @@ TEST(DetectCheckerboard, NumbersTheCornersAsThePrintedBoard) {
     // Detector corners are ~0.2 px from the truth; a turned numbering puts them a board away.
     EXPECT_LT(MedianIdError(found, GroundTruth(sensor, view)), 1.0) << c.cols << "x" << c.rows << " roll " << c.roll_deg;
   }
+}
+
+}  // namespace
+}  // namespace omnical
+
+namespace omnical {
+namespace {
+
+// A flat printed board on grey: squares_x x squares_y squares of 24 px (ink at the top-left
+// square), a white margin of one square, its first inner corner at `origin`.
+cv::Mat FlatBoard(int squares_x, int squares_y, cv::Point origin, cv::Size image_size) {
+  constexpr int kSquarePx = 24;
+  cv::Mat image(image_size, CV_8UC1, cv::Scalar(120));
+  const cv::Point top_left = origin - cv::Point(kSquarePx, kSquarePx);
+  cv::rectangle(image, cv::Rect(top_left - cv::Point(kSquarePx, kSquarePx), cv::Size((squares_x + 2) * kSquarePx, (squares_y + 2) * kSquarePx)),
+                cv::Scalar(235), cv::FILLED);
+  for (int y = 0; y < squares_y; ++y)
+    for (int x = 0; x < squares_x; ++x)
+      if ((x + y) % 2 == 0)
+        cv::rectangle(image, cv::Rect(top_left + cv::Point(x * kSquarePx, y * kSquarePx), cv::Size(kSquarePx, kSquarePx)),
+                      cv::Scalar(25), cv::FILLED);
+  cv::GaussianBlur(image, image, cv::Size(5, 5), 1.0);
+  return image;
+}
+
+// The corner numbering is a proper grid: corner (r, c) at p0 + c ux + r uy with 24 px steps,
+// ux x uy > 0 (the complete search's handedness, image y down), to a tolerance: OpenCV's
+// corners and the grown ones (cornerSubPix's) differ by up to 0.4 px on this blurred print,
+// and next to a sharp cut by up to 0.73 px (measured).
+void ExpectProperGrid(const std::vector<BoardCorner>& corners, double tolerance_px) {
+  ASSERT_GE(corners.size(), 3u);
+  std::map<std::pair<int, int>, Eigen::Vector2d> at;
+  for (const BoardCorner& c : corners) at[{c.row_down, c.col}] = c.pixel;
+  const BoardCorner& first = corners.front();
+  Eigen::Vector2d ux = Eigen::Vector2d::Zero(), uy = Eigen::Vector2d::Zero();
+  int x_pairs = 0, y_pairs = 0;
+  for (const BoardCorner& c : corners) {
+    if (at.count({c.row_down, c.col + 1})) ux += at[{c.row_down, c.col + 1}] - c.pixel, ++x_pairs;
+    if (at.count({c.row_down + 1, c.col})) uy += at[{c.row_down + 1, c.col}] - c.pixel, ++y_pairs;
+  }
+  ux /= std::max(1, x_pairs);
+  uy /= std::max(1, y_pairs);
+  EXPECT_NEAR(ux.norm(), 24.0, 0.3);
+  EXPECT_NEAR(uy.norm(), 24.0, 0.3);
+  EXPECT_GT(ux.x() * uy.y() - ux.y() * uy.x(), 0.0);
+  for (const BoardCorner& c : corners)
+    EXPECT_LT((c.pixel - (first.pixel + (c.col - first.col) * ux + (c.row_down - first.row_down) * uy)).norm(), tolerance_px)
+        << c.row_down << "," << c.col;
+}
+
+// calib/partial_checkerboard.h on flat prints: a whole board is placed; one with a corner
+// of squares painted over (as the rim cuts a board) is placed with the hidden corners
+// missing; one cut to half its width is found but not placed (the half could be either);
+// a pattern larger than the board (tiles) is refused.
+TEST(PartialCheckerboard, PlacesABoardThatSpansItsExtentOnly) {
+  const cv::Size pattern(8, 6);  // inner corners: 9 x 7 squares
+  const cv::Mat whole = FlatBoard(9, 7, cv::Point(80, 70), cv::Size(400, 320));
+  const std::optional<PartialCheckerboard> full = FindPartialCheckerboard(whole, pattern);
+  ASSERT_TRUE(full);
+  EXPECT_TRUE(full->placed);
+  EXPECT_EQ(full->corners.size(), 48u);
+  ExpectProperGrid(full->corners, 0.5);
+
+  cv::Mat cut = whole.clone();  // the bottom-right 2 x 2 inner corners painted over, as by a rim
+  cv::rectangle(cut, cv::Rect(80 + 5 * 24 + 12, 70 + 3 * 24 + 12, 200, 200), cv::Scalar(0), cv::FILLED);
+  const std::optional<PartialCheckerboard> partial = FindPartialCheckerboard(cut, pattern);
+  ASSERT_TRUE(partial);
+  EXPECT_TRUE(partial->placed);
+  EXPECT_EQ(partial->corners.size(), 48u - 4u);
+  ExpectProperGrid(partial->corners, 1.0);
+
+  cv::Mat half = whole.clone();
+  cv::rectangle(half, cv::Rect(80 + 3 * 24 + 12, 0, 400, 320), cv::Scalar(0), cv::FILLED);
+  const std::optional<PartialCheckerboard> short_part = FindPartialCheckerboard(half, pattern);
+  ASSERT_TRUE(short_part);
+  EXPECT_FALSE(short_part->placed);
+
+  const cv::Mat tiles = FlatBoard(16, 12, cv::Point(24, 24), cv::Size(400, 320));
+  EXPECT_FALSE(FindPartialCheckerboard(tiles, pattern));
 }
 
 }  // namespace

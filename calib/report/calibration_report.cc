@@ -108,17 +108,24 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
 
 // Per-view RMS over all corners: the fitted views, then the held-out ones, with the
 // training RMS as a line to compare with.
-void WriteHoldoutFigure(const std::string& path, const CalibrationRecord& record, const HeldOutViews& held) {
-  PlotPanel panel("Per-view RMS, all corners: fitted views (left), held-out views (right)", "view", "RMS (px)");
+void WriteHoldoutFigure(const std::string& path, const CalibrationResult& result, const HeldOutViews& held) {
+  // Both kinds of bar over all of a view's corners, as the held-out RMS is (outliers are a
+  // fit's notion; a held-out view has none).
+  PlotPanel panel("Per-view RMS over all corners: fitted views (left), held-out views (right)", "view", "RMS (px)");
   std::vector<double> x, y;
   double v = 0.0;
-  for (const auto& [image, rms] : record.per_view_rms_px) {
-    if (!std::isfinite(rms)) continue;
+  for (const std::vector<Eigen::Vector2d>& residuals : result.fit.residuals_px) {
+    double square = 0.0;
+    int count = 0;
+    for (const Eigen::Vector2d& e : residuals)
+      if (e.allFinite()) square += e.squaredNorm(), ++count;
+    if (count == 0) continue;
+    const double rms = std::sqrt(square / count);
     x.insert(x.end(), {v - 0.4, v - 0.4, v + 0.4, v + 0.4});
     y.insert(y.end(), {0.0, rms, rms, 0.0});
     v += 1.0;
   }
-  panel.series.push_back(PlotSeries("fitted (inliers)", x, y, SeriesColor(0)));
+  panel.series.push_back(PlotSeries("fitted", x, y, SeriesColor(0)));
   x.clear(), y.clear();
   for (const std::string& image : held.images) {
     const double rms = held.per_view_rms_px.count(image) ? held.per_view_rms_px.at(image) : NAN;
@@ -130,8 +137,9 @@ void WriteHoldoutFigure(const std::string& path, const CalibrationRecord& record
   }
   panel.series.push_back(PlotSeries("held out", x, y, SeriesColor(1)));
   char label[120];
-  std::snprintf(label, sizeof label, "training RMS %.3f px, held out %.3f px", record.rms_all_px, held.rms_px);
-  PlotSeries training(label, {-0.5, v - 0.5}, {record.rms_all_px, record.rms_all_px}, SeriesColor(2));
+  const double training_rms_px = result.record.rms_all_px;
+  std::snprintf(label, sizeof label, "training RMS %.3f px, held out %.3f px", training_rms_px, held.rms_px);
+  PlotSeries training(label, {-0.5, v - 0.5}, {training_rms_px, training_rms_px}, SeriesColor(2));
   training.dashed = true;
   panel.series.push_back(training);
   WritePng(path, RenderPanel(panel, 800, 500));
@@ -146,7 +154,7 @@ void WriteCalibrationReport(const std::string& dir, const CalibrationResult& res
   if (const auto& cross = result.record.cross_validation)
     WriteProjectionDiffFigure((path / "cross_validation.png").string(), cross->diff, result.sensor.image_width_px(),
                               result.sensor.image_height_px(), "two halves of the views, each calibrated: half 2 against half 1");
-  if (const auto& held = result.record.holdout) WriteHoldoutFigure((path / "holdout.png").string(), result.record, *held);
+  if (const auto& held = result.record.holdout) WriteHoldoutFigure((path / "holdout.png").string(), result, *held);
   for (size_t k = 0; k < result.predicted.size(); ++k)
     WritePredictedErrorMap((path / ("predicted_error_" + std::to_string(k) + ".png")).string(), result.sensor,
                            result.predicted[k], options.predicted_error_step_px, options.max_predicted_error_px,

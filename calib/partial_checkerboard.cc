@@ -1,0 +1,154 @@
+#include "calib/partial_checkerboard.h"
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <set>
+#include <utility>
+
+#include "calib/checkerboard_candidates.h"
+
+namespace omnical {
+namespace {
+
+using Index = std::pair<int, int>;  // (row down, col) in the found part's own numbering
+using Grid = std::map<Index, Eigen::Vector2d>;
+
+// One step beyond `from` along direction (dr, dc), extrapolated from the corners behind it
+// (quadratic along the line where three are known: the grid bends in an omni image); false
+// where the line has only one known corner.
+bool Predict(const Grid& grid, Index from, int dr, int dc, Eigen::Vector2d* predicted) {
+  const auto behind = grid.find({from.first - dr, from.second - dc});
+  if (behind == grid.end()) return false;
+  const Eigen::Vector2d& p1 = grid.at(from);
+  const auto further = grid.find({from.first - 2 * dr, from.second - 2 * dc});
+  *predicted = further != grid.end() ? Eigen::Vector2d(3.0 * p1 - 3.0 * behind->second + further->second)
+                                     : Eigen::Vector2d(2.0 * p1 - behind->second);
+  return true;
+}
+
+// The grid step across direction (dr, dc) at a corner, from a known neighbour on either
+// side; zero when it has none.
+Eigen::Vector2d StepAcross(const Grid& grid, Index at, int dr, int dc) {
+  const Eigen::Vector2d& p = grid.at(at);
+  if (const auto next = grid.find({at.first + dc, at.second + dr}); next != grid.end()) return next->second - p;
+  if (const auto previous = grid.find({at.first - dc, at.second - dr}); previous != grid.end()) return p - previous->second;
+  return Eigen::Vector2d::Zero();
+}
+
+// The rows and columns the grid's corners span.
+struct Extent {
+  int min_row = INT32_MAX, max_row = INT32_MIN, min_col = INT32_MAX, max_col = INT32_MIN;
+  int rows() const { return max_row - min_row + 1; }
+  int cols() const { return max_col - min_col + 1; }
+};
+Extent ExtentOf(const Grid& grid) {
+  Extent e;
+  for (const auto& [index, pixel] : grid) {
+    e.min_row = std::min(e.min_row, index.first), e.max_row = std::max(e.max_row, index.first);
+    e.min_col = std::min(e.min_col, index.second), e.max_col = std::max(e.max_col, index.second);
+  }
+  return e;
+}
+
+// Grows the part corner by corner (see the header); false when it outgrows `longest`
+// corners along an axis (a pattern larger than the board).
+bool Grow(const cv::Mat& grey, double threshold, int longest, Grid* grid) {
+  std::set<Index> refused;
+  constexpr std::array<std::array<int, 2>, 4> kDirections = {{{1, 0}, {-1, 0}, {0, 1}, {0, -1}}};
+  for (bool grew = true; grew;) {
+    grew = false;
+    std::vector<Index> known;
+    for (const auto& [index, pixel] : *grid) known.push_back(index);
+    for (const Index& at : known)
+      for (const auto& [dr, dc] : kDirections) {
+        const Index next{at.first + dr, at.second + dc};
+        if (grid->count(next) || refused.count(next)) continue;
+        Eigen::Vector2d predicted;
+        const Eigen::Vector2d across = StepAcross(*grid, at, dr, dc);
+        if (!Predict(*grid, at, dr, dc, &predicted) || across.isZero()) continue;
+        const Eigen::Vector2d along = predicted - grid->at(at);
+        const double step_px = std::min(along.norm(), across.norm());
+        const int half_window = std::max(2, static_cast<int>(0.3 * step_px));
+        const double score = XJunctionScore(grey, predicted, along, across);
+        if (!(score > threshold) || predicted.x() < half_window + 1 || predicted.y() < half_window + 1 ||
+            predicted.x() > grey.cols - half_window - 2 || predicted.y() > grey.rows - half_window - 2) {
+          refused.insert(next);
+          continue;
+        }
+        std::vector<cv::Point2f> point{cv::Point2f(static_cast<float>(predicted.x()), static_cast<float>(predicted.y()))};
+        cv::cornerSubPix(grey, point, cv::Size(half_window, half_window), cv::Size(-1, -1),
+                         cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 20, 0.05));
+        const Eigen::Vector2d refined(point[0].x, point[0].y);
+        if ((refined - predicted).norm() > 0.25 * step_px || !(XJunctionScore(grey, refined, along, across) > threshold)) {
+          refused.insert(next);
+          continue;
+        }
+        (*grid)[next] = refined;
+        grew = true;
+      }
+    if (const Extent e = ExtentOf(*grid); e.rows() > longest || e.cols() > longest) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<PartialCheckerboard> FindPartialCheckerboard(const cv::Mat& grey, cv::Size pattern,
+                                                           double junction_contrast_fraction) {
+  CV_Assert(grey.type() == CV_8UC1);
+  const cv::Size minimum(std::min(4, pattern.width), std::min(4, pattern.height));
+  std::vector<cv::Point2f> found;
+  cv::Mat meta;
+  const uint64_t caller_rng = cv::theRNG().state;  // see FindCheckerboardCandidates
+  cv::theRNG().state = cv::RNG().state;
+  const bool ok = cv::findChessboardCornersSB(grey, minimum, found,
+                                              cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY | cv::CALIB_CB_LARGER, meta);
+  cv::theRNG().state = caller_rng;
+  if (!ok || meta.empty() || static_cast<int>(found.size()) != meta.rows * meta.cols) return std::nullopt;
+  CheckerGrid part;
+  part.rows = meta.rows;
+  part.cols = meta.cols;
+  Grid grid;
+  for (int i = 0; i < static_cast<int>(found.size()); ++i) {
+    part.corners_px.emplace_back(found[i].x, found[i].y);
+    grid[{i / part.cols, i % part.cols}] = part.corners_px.back();
+  }
+  // With CALIB_CB_LARGER the order can come transposed (measured on a flat print: rows of
+  // the meta array running down the image's columns), a reflection of the numbering: made
+  // right-handed as the complete search's (column step x row step > 0, image y down).
+  const Eigen::Vector2d col_step = part.at(0, 1) - part.at(0, 0), row_step = part.at(1, 0) - part.at(0, 0);
+  if (col_step.x() * row_step.y() - col_step.y() * row_step.x() < 0.0) {
+    Grid transposed;
+    for (const auto& [index, pixel] : grid) transposed[{index.second, index.first}] = pixel;
+    grid = std::move(transposed);
+  }
+  const double threshold = junction_contrast_fraction * GridContrast(grey, part);
+  if (!(threshold > 0.0) || !Grow(grey, threshold, std::max(pattern.width, pattern.height), &grid)) return std::nullopt;
+
+  const Extent e = ExtentOf(grid);
+  const int rows = e.rows(), cols = e.cols(), min_row = e.min_row, max_row = e.max_row, min_col = e.min_col;
+  PartialCheckerboard out;
+  out.placed = true;
+  if (rows == pattern.height && cols == pattern.width) {
+    for (const auto& [index, pixel] : grid) out.corners.push_back({index.first - min_row, index.second - min_col, pixel});
+  } else if (rows == pattern.width && cols == pattern.height) {
+    // Turned a quarter: (row, col) -> (col, last row - row), a rotation of the numbering
+    // (the image's handedness kept).
+    for (const auto& [index, pixel] : grid) out.corners.push_back({index.second - min_col, max_row - index.first, pixel});
+  } else {
+    out.placed = false;
+    for (const auto& [index, pixel] : grid) out.corners.push_back({index.first - min_row, index.second - min_col, pixel});
+  }
+  std::sort(out.corners.begin(), out.corners.end(), [](const BoardCorner& a, const BoardCorner& b) {
+    return std::make_pair(a.row_down, a.col) < std::make_pair(b.row_down, b.col);
+  });
+  return out;
+}
+
+}  // namespace omnical
