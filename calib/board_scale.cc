@@ -81,9 +81,12 @@ Fitted FitAtScale(const std::vector<ScaledCornerError>& corners, const TargetPos
 }  // namespace
 
 BoardScale CheckBoardScale(const Sensor& sensor, const CalibrationTarget& target, const ImageDetections& image,
-                           const TargetPose& pose, double sigma_px, const BoardScaleOptions& options) {
+                           const TargetPose& pose, double sigma_px, const BoardScaleOptions& options,
+                           const BoardWarp& warp) {
   std::map<int, Eigen::Vector3d> points;
   for (const TargetCorner& c : target.corners()) points[c.id] = c.point_in_target;
+  if (!warp.IsZero())  // along the board's normal, as the bundle fit's cost bends it
+    for (const auto& [id, basis] : BoardWarp::Basis(target)) points[id].z() += warp.OffsetMm(basis);
   std::vector<ScaledCornerError> corners;
   for (const CornerObservation& c : image.corners) {
     const auto point = points.find(c.id);

@@ -363,7 +363,8 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     std::vector<BoardScale> checks(views.detections.images.size());
     for (size_t v = 0; v < checks.size(); ++v)
       if (fit.view_left_out[v].empty())
-        checks[v] = CheckBoardScale(*fit.sensor, input.target, views.detections.images[v], fit.poses[v], fit.sigma_px);
+        checks[v] = CheckBoardScale(*fit.sensor, input.target, views.detections.images[v], fit.poses[v], fit.sigma_px,
+                                    BoardScaleOptions(), fit.board_warp ? fit.board_warp->warp : fit_options.board_warp);
     std::vector<size_t> refused;
     for (size_t v = 0; v < checks.size(); ++v) {
       if (!checks[v].refused) continue;
