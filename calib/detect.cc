@@ -1,5 +1,6 @@
 #include "calib/detect.h"
 
+#include "calib/aprilgrid_completion.h"
 #include "calib/bilinear.h"
 #include "calib/partial_checkerboard.h"
 #include "calib/virtual_view.h"
@@ -143,17 +144,6 @@ std::vector<BoardCorner> BoardCorners(const std::vector<Eigen::Vector2d>& grid_p
 // quarter of the image per radian.
 double OmniPxPerRad(const Sensor& guess) {
   return 0.5 * std::min(guess.image_width_px(), guess.image_height_px()) / 2.0;
-}
-
-// A virtual view of size_px square looking along a camera-frame direction from the
-// guess's reference viewpoint on the axis, image "down" towards the mirror's -z.
-VirtualView ViewAlong(const Sensor& guess, const Eigen::Vector3d& forward_in_camera, int size_px, double focal_px) {
-  const ProjectionCache& cache = guess.cache();
-  const double viewpoint_z = cache.guess.valid() ? cache.guess.reference_viewpoint_mm() : 0.0;
-  const Eigen::Vector3d centre = cache.camera_from_mirror_rotation * Eigen::Vector3d(0, 0, viewpoint_z) +
-                                 cache.camera_from_mirror_translation;
-  const Eigen::Vector3d down = cache.camera_from_mirror_rotation * -Eigen::Vector3d::UnitZ();
-  return VirtualView(guess, ViewFrame(forward_in_camera, down), centre, focal_px, size_px, size_px);
 }
 
 // A sweep of views looking outwards along (Omega, azimuth) of the mirror frame, Omega
@@ -317,7 +307,7 @@ ImageDetections DetectThroughVirtualViews(const CalibrationTarget& target, const
   for (const auto& [id, corners] : merged)
     for (int k = 0; k < 4; ++k) out.corners.push_back({4 * id + k, corners[k]});
   out.image = raw.image;
-  return out;
+  return CompleteAprilGrid(target, grey, guess, out);
 }
 
 ImageDetections DetectTarget(const CalibrationTarget& target, const cv::Mat& grey) {

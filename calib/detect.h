@@ -57,7 +57,8 @@ ImageDetections DetectTarget(const CalibrationTarget& target, const cv::Mat& gre
 // AprilTag grids: a sweep of pinhole views (magnified ~2x, from the mirror's reference
 // viewpoint); tags are detected there (no mirror reversal in a perspective view). Per tag,
 // the view where it is most central wins; tags found only in the omni image are kept from
-// `raw`.
+// `raw`; then tags no view could decode are placed from the decoded ones
+// (calib/aprilgrid_completion.h).
 // Checkerboards, only when `raw` has none (all or none per image): a sweep of wide views
 // (90 deg) where a board curved near the rim or the inner radius is nearly straight, then
 // a view aimed at the board found; ids as in DetectCheckerboard. `raw` otherwise.

@@ -61,6 +61,37 @@ bool VirtualView::ToOmni(const Eigen::Vector2d& view_px, Eigen::Vector2d* omni_p
   return true;
 }
 
+bool VirtualView::FromOmni(const Eigen::Vector2d& omni_px, const Eigen::Vector2d& start_view_px,
+                           Eigen::Vector2d* view_px) const {
+  Eigen::Vector2d at = start_view_px;
+  constexpr double kStepPx = 0.5;  // finite differences across the bilinear table
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    Eigen::Vector2d here, right, below;
+    if (!ToOmni(at, &here) || !ToOmni(at + Eigen::Vector2d(kStepPx, 0), &right) ||
+        !ToOmni(at + Eigen::Vector2d(0, kStepPx), &below))
+      return false;
+    Eigen::Matrix2d jacobian;
+    jacobian << (right - here) / kStepPx, (below - here) / kStepPx;
+    if (std::abs(jacobian.determinant()) < 1e-12) return false;
+    const Eigen::Vector2d step = jacobian.inverse() * (omni_px - here);
+    at += step;
+    if (step.norm() < 0.01) {
+      *view_px = at;
+      return ToOmni(at, &here);
+    }
+  }
+  return false;
+}
+
+VirtualView ViewAlong(const Sensor& sensor, const Eigen::Vector3d& forward_in_camera, int size_px, double focal_px) {
+  const ProjectionCache& cache = sensor.cache();
+  const double viewpoint_z = cache.guess.valid() ? cache.guess.reference_viewpoint_mm() : 0.0;
+  const Eigen::Vector3d centre = cache.camera_from_mirror_rotation * Eigen::Vector3d(0, 0, viewpoint_z) +
+                                 cache.camera_from_mirror_translation;
+  const Eigen::Vector3d down = cache.camera_from_mirror_rotation * -Eigen::Vector3d::UnitZ();
+  return VirtualView(sensor, ViewFrame(forward_in_camera, down), centre, focal_px, size_px, size_px);
+}
+
 Eigen::Matrix3d ViewFrame(const Eigen::Vector3d& forward, const Eigen::Vector3d& down_hint) {
   const Eigen::Vector3d f = forward.normalized();
   Eigen::Vector3d right = down_hint.cross(f);  // then f x right is down_hint's part across f

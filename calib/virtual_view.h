@@ -31,6 +31,10 @@ class VirtualView {
   Eigen::Vector2d ToView(const Eigen::Vector3d& direction_in_camera) const;
   // Direction (unit, camera frame) from the view's centre through a view pixel.
   Eigen::Vector3d Direction(const Eigen::Vector2d& view_px) const;
+  // View pixel of an omni pixel: Newton steps on the table from `start_view_px` (e.g.
+  // ToView of the pixel's ray direction, which the mirror's parallax puts a little off);
+  // false when they leave the view or do not converge to 0.01 px.
+  bool FromOmni(const Eigen::Vector2d& omni_px, const Eigen::Vector2d& start_view_px, Eigen::Vector2d* view_px) const;
   // Omni pixel of a view pixel, bilinear in the table; false outside the view or next to
   // a ray that missed.
   bool ToOmni(const Eigen::Vector2d& view_px, Eigen::Vector2d* omni_px) const;
@@ -43,6 +47,10 @@ class VirtualView {
   double focal_px_;
   cv::Mat map_x_, map_y_;  // CV_32F omni pixel per view pixel; -1 where the ray misses
 };
+
+// A square view looking along a camera-frame direction from the sensor's reference
+// viewpoint on the axis (its axial analysis), image "down" towards the mirror's -z.
+VirtualView ViewAlong(const Sensor& sensor, const Eigen::Vector3d& forward_in_camera, int size_px, double focal_px);
 
 // Right-handed view frame (right, down, forward) looking along `forward`, with image "down"
 // as close as possible to `down_hint`.
