@@ -52,7 +52,9 @@ double BorderContrast(const cv::Mat& view, const cv::Mat& board_to_view, const E
 
 ImageDetections CompleteAprilGrid(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& guess,
                                   const ImageDetections& found) {
-  if (target.type() != CalibrationTarget::Type::kAprilGrid) return found;
+  // tagStandard41h12's quad is white inside its black ring: the border test below reads
+  // tag36h11's black square.
+  if (target.type() != CalibrationTarget::Type::kAprilGrid || target.family() != "tag36h11") return found;
   std::map<int, Eigen::Vector3d> board_mm;
   for (const TargetCorner& c : target.corners()) board_mm[c.id] = c.point_in_target;
   std::set<int> decoded;
@@ -111,9 +113,12 @@ ImageDetections CompleteAprilGrid(const CalibrationTarget& target, const cv::Mat
     return cv::findHomography(board_points, view_points, 0);
   };
   std::vector<double> contrasts;
-  for (const auto& [tag, corners] : in_view)
-    if (const double c = BorderContrast(image, local_homography(tag), low_of(tag), size_mm, gap_mm); std::isfinite(c))
+  for (const auto& [tag, corners] : in_view) {
+    const cv::Mat homography = local_homography(tag);
+    if (homography.empty()) continue;
+    if (const double c = BorderContrast(image, homography, low_of(tag), size_mm, gap_mm); std::isfinite(c))
       contrasts.push_back(c);
+  }
   if (contrasts.empty()) return found;
   std::nth_element(contrasts.begin(), contrasts.begin() + contrasts.size() / 2, contrasts.end());
   const double threshold = 0.5 * contrasts[contrasts.size() / 2];

@@ -21,7 +21,8 @@
 namespace omnical {
 
 // `found` with the predicted tags added (4 corners each); `found` as it is for another
-// target type, fewer than 4 decoded tags, or when the homography cannot be fitted.
+// target type or family (tag36h11 only: the test reads its black square), fewer than 4
+// decoded tags, or when no view can be aimed at them.
 ImageDetections CompleteAprilGrid(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& guess,
                                   const ImageDetections& found);
 

@@ -11,6 +11,7 @@
 #include <set>
 #include <utility>
 
+#include "calib/bilinear.h"
 #include "calib/checkerboard_candidates.h"
 
 namespace omnical {
@@ -97,6 +98,45 @@ bool Grow(const cv::Mat& grey, double threshold, int longest, Grid* grid) {
   return true;
 }
 
+// Whether at least three of the part's four sides show the board's white margin: a point
+// one step beyond a corner on that side that is no X-junction and has paper half a step
+// further out (brighter than the mean of the part's squares: the midpoint of ink and
+// paper). Growth stops at a margin, but also at the rim, a dark edge or the image's edge:
+// a patch of a larger pattern (tiles) cut there to the board's size shows no paper; a
+// board whose one side lies beyond the rim (realistic render rim0) shows it on three.
+bool MarginOnThreeSides(const cv::Mat& grey, double threshold, const Grid& grid) {
+  double square_sum = 0.0;
+  int squares = 0;
+  for (const auto& [index, pixel] : grid)
+    if (const auto opposite = grid.find({index.first + 1, index.second + 1}); opposite != grid.end()) {
+      const Eigen::Vector2d centre = 0.5 * (pixel + opposite->second);
+      if (const double value = Bilinear<uchar>(grey, centre.x(), centre.y()); std::isfinite(value)) square_sum += value, ++squares;
+    }
+  if (squares == 0) return false;
+  const double ink_paper_midpoint = square_sum / squares;
+  const Extent e = ExtentOf(grid);
+  struct Side {
+    int dr, dc;
+  };
+  int sides_with_margin = 0;
+  for (const Side side : {Side{-1, 0}, Side{1, 0}, Side{0, -1}, Side{0, 1}}) {
+    bool margin_seen = false;
+    for (const auto& [index, pixel] : grid) {
+      const bool on_side = (side.dr < 0 && index.first == e.min_row) || (side.dr > 0 && index.first == e.max_row) ||
+                           (side.dc < 0 && index.second == e.min_col) || (side.dc > 0 && index.second == e.max_col);
+      Eigen::Vector2d beyond;
+      const Eigen::Vector2d across = StepAcross(grid, index, side.dr, side.dc);
+      if (!on_side || across.isZero() || !Predict(grid, index, side.dr, side.dc, &beyond)) continue;
+      const double score = XJunctionScore(grey, beyond, beyond - pixel, across);
+      const Eigen::Vector2d paper = beyond + 0.5 * (beyond - pixel);
+      const double paper_grey = Bilinear<uchar>(grey, paper.x(), paper.y());
+      if (std::isfinite(score) && score <= threshold && paper_grey > ink_paper_midpoint) margin_seen = true;
+    }
+    sides_with_margin += margin_seen;
+  }
+  return sides_with_margin >= 3;
+}
+
 }  // namespace
 
 std::optional<PartialCheckerboard> FindPartialCheckerboard(const cv::Mat& grey, cv::Size pattern,
@@ -133,16 +173,18 @@ std::optional<PartialCheckerboard> FindPartialCheckerboard(const cv::Mat& grey, 
 
   const Extent e = ExtentOf(grid);
   const int rows = e.rows(), cols = e.cols(), min_row = e.min_row, max_row = e.max_row, min_col = e.min_col;
+  const bool fits_upright = rows <= pattern.height && cols <= pattern.width;
+  const bool fits_turned = rows <= pattern.width && cols <= pattern.height;
+  if (!fits_upright && !fits_turned) return std::nullopt;  // larger than the board
+  const bool spans_upright = rows == pattern.height && cols == pattern.width;
+  const bool spans_turned = rows == pattern.width && cols == pattern.height;
   PartialCheckerboard out;
-  out.placed = true;
-  if (rows == pattern.height && cols == pattern.width) {
-    for (const auto& [index, pixel] : grid) out.corners.push_back({index.first - min_row, index.second - min_col, pixel});
-  } else if (rows == pattern.width && cols == pattern.height) {
+  out.placed = (spans_upright || spans_turned) && MarginOnThreeSides(grey, threshold, grid);
+  if (out.placed && !spans_upright) {
     // Turned a quarter: (row, col) -> (col, last row - row), a rotation of the numbering
     // (the image's handedness kept).
     for (const auto& [index, pixel] : grid) out.corners.push_back({index.second - min_col, max_row - index.first, pixel});
   } else {
-    out.placed = false;
     for (const auto& [index, pixel] : grid) out.corners.push_back({index.first - min_row, index.second - min_col, pixel});
   }
   std::sort(out.corners.begin(), out.corners.end(), [](const BoardCorner& a, const BoardCorner& b) {
