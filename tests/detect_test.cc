@@ -576,12 +576,16 @@ void ExpectProperGrid(const std::vector<BoardCorner>& corners, double tolerance_
 // a pattern larger than the board (tiles) is refused.
 TEST(PartialCheckerboard, PlacesABoardThatSpansItsExtentOnly) {
   const cv::Size pattern(8, 6);  // inner corners: 9 x 7 squares
+  // A whole board, and a portrait print (7 x 9 squares: the board turned a quarter, placed
+  // through the quarter turn), each placed with all 48 corners as a proper grid.
   const cv::Mat whole = FlatBoard(9, 7, cv::Point(80, 70), cv::Size(400, 320));
-  const std::optional<PartialCheckerboard> full = FindPartialCheckerboard(whole, pattern);
-  ASSERT_TRUE(full);
-  EXPECT_TRUE(full->placed);
-  EXPECT_EQ(full->corners.size(), 48u);
-  ExpectProperGrid(full->corners, 0.5);
+  for (const cv::Mat& print : {whole, FlatBoard(7, 9, cv::Point(80, 50), cv::Size(320, 400))}) {
+    const std::optional<PartialCheckerboard> full = FindPartialCheckerboard(print, pattern);
+    ASSERT_TRUE(full);
+    EXPECT_TRUE(full->placed);
+    EXPECT_EQ(full->corners.size(), 48u);
+    ExpectProperGrid(full->corners, 0.5);
+  }
 
   cv::Mat cut = whole.clone();  // the bottom-right 2 x 2 inner corners painted over, as by a rim
   cv::rectangle(cut, cv::Rect(80 + 5 * 24 + 12, 70 + 3 * 24 + 12, 200, 200), cv::Scalar(0), cv::FILLED);
@@ -597,15 +601,6 @@ TEST(PartialCheckerboard, PlacesABoardThatSpansItsExtentOnly) {
   for (const BoardCorner& corner : partial->corners) missing.erase({corner.row_down, corner.col});
   const std::set<std::pair<int, int>> bottom_right = {{4, 6}, {4, 7}, {5, 6}, {5, 7}}, top_left = {{0, 0}, {0, 1}, {1, 0}, {1, 1}};
   EXPECT_TRUE(missing == bottom_right || missing == top_left) << "the painted corners, or the same turned 180 deg";
-
-  // A portrait print (7 x 9 squares: the board turned a quarter) is placed through the
-  // quarter turn, as a proper grid.
-  const cv::Mat portrait = FlatBoard(7, 9, cv::Point(80, 50), cv::Size(320, 400));
-  const std::optional<PartialCheckerboard> turned = FindPartialCheckerboard(portrait, pattern);
-  ASSERT_TRUE(turned);
-  EXPECT_TRUE(turned->placed);
-  EXPECT_EQ(turned->corners.size(), 48u);
-  ExpectProperGrid(turned->corners, 0.5);
 
   // Tiles seen through a window exactly the board's size (black beyond, as a rim): no side
   // shows a margin, so the patch is not placed.
