@@ -140,22 +140,9 @@ CheckerGrid GrowPattern(const cv::Mat& grey, CheckerGrid grid, double threshold)
       if (std::count(junctions.begin(), junctions.end(), 1) != static_cast<int>(junctions.size())) continue;
       double step_px = HUGE_VAL;
       for (size_t i = 0; i < beyond.size(); ++i) step_px = std::min(step_px, (beyond[i] - lines[0][i]).norm());
-      std::vector<cv::Point2f> points;
-      for (const Eigen::Vector2d& p : beyond) points.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
-      const int half_window = std::max(2, static_cast<int>(0.3 * step_px));
-      bool inside = true;
-      for (const cv::Point2f& p : points)
-        inside = inside && p.x >= half_window + 1 && p.y >= half_window + 1 && p.x < grey.cols - half_window - 2 &&
-                 p.y < grey.rows - half_window - 2;
-      if (!inside) continue;  // the pattern runs off the image: masking what is inside is enough
-      cv::cornerSubPix(grey, points, cv::Size(half_window, half_window), cv::Size(-1, -1),
-                       cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 20, 0.05));
+      // A point off the image: the pattern runs off it, and masking what is inside is enough.
       bool on_junctions = true;
-      for (size_t i = 0; i < beyond.size(); ++i) {
-        const Eigen::Vector2d refined(points[i].x, points[i].y);
-        on_junctions = on_junctions && (refined - beyond[i]).norm() < 0.25 * step_px;
-        beyond[i] = refined;
-      }
+      for (Eigen::Vector2d& p : beyond) on_junctions = on_junctions && PullOntoJunction(grey, step_px, &p);
       if (!on_junctions) continue;
       grid = Extended(grid, edge, beyond);
       grew = true;
@@ -186,6 +173,19 @@ void MaskGrid(const CheckerGrid& grid, cv::Mat* image) {
 }
 
 }  // namespace
+
+bool PullOntoJunction(const cv::Mat& grey, double step_px, Eigen::Vector2d* point) {
+  const int half_window = std::max(2, static_cast<int>(0.3 * step_px));
+  const Eigen::Vector2d start = *point;
+  if (!(start.x() >= half_window + 1 && start.y() >= half_window + 1 && start.x() < grey.cols - half_window - 2 &&
+        start.y() < grey.rows - half_window - 2))
+    return false;
+  std::vector<cv::Point2f> refined{cv::Point2f(static_cast<float>(start.x()), static_cast<float>(start.y()))};
+  cv::cornerSubPix(grey, refined, cv::Size(half_window, half_window), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 20, 0.05));
+  *point = Eigen::Vector2d(refined[0].x, refined[0].y);
+  return (*point - start).norm() < 0.25 * step_px;
+}
 
 const char* GridEdgeName(GridEdge edge) {
   switch (edge) {

@@ -35,6 +35,12 @@ struct CheckerGrid {
 double XJunctionScore(const cv::Mat& grey, const Eigen::Vector2d& point_px, const Eigen::Vector2d& step_a_px,
                       const Eigen::Vector2d& step_b_px);
 
+// A predicted X-junction pulled onto the image's junction by cornerSubPix (half window 0.3
+// of the grid step `step_px`, so it stays inside the point's four squares): false when the
+// window leaves the image or the point moves more than a quarter step (it found another
+// junction, or none).
+bool PullOntoJunction(const cv::Mat& grey, double step_px, Eigen::Vector2d* point);
+
 enum class GridEdge { kTop, kBottom, kLeft, kRight };  // first row, last row, first column, last column
 const char* GridEdgeName(GridEdge edge);               // "first row", ..., "last column"
 

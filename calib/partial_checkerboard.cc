@@ -75,18 +75,9 @@ bool Grow(const cv::Mat& grey, double threshold, int longest, Grid* grid) {
         if (!Predict(*grid, at, dr, dc, &predicted) || across.isZero()) continue;
         const Eigen::Vector2d along = predicted - grid->at(at);
         const double step_px = std::min(along.norm(), across.norm());
-        const int half_window = std::max(2, static_cast<int>(0.3 * step_px));
-        const double score = XJunctionScore(grey, predicted, along, across);
-        if (!(score > threshold) || predicted.x() < half_window + 1 || predicted.y() < half_window + 1 ||
-            predicted.x() > grey.cols - half_window - 2 || predicted.y() > grey.rows - half_window - 2) {
-          refused.insert(next);
-          continue;
-        }
-        std::vector<cv::Point2f> point{cv::Point2f(static_cast<float>(predicted.x()), static_cast<float>(predicted.y()))};
-        cv::cornerSubPix(grey, point, cv::Size(half_window, half_window), cv::Size(-1, -1),
-                         cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 20, 0.05));
-        const Eigen::Vector2d refined(point[0].x, point[0].y);
-        if ((refined - predicted).norm() > 0.25 * step_px || !(XJunctionScore(grey, refined, along, across) > threshold)) {
+        Eigen::Vector2d refined = predicted;
+        if (!(XJunctionScore(grey, predicted, along, across) > threshold) || !PullOntoJunction(grey, step_px, &refined) ||
+            !(XJunctionScore(grey, refined, along, across) > threshold)) {
           refused.insert(next);
           continue;
         }
