@@ -17,6 +17,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <utility>
 #include <stdexcept>
@@ -25,16 +26,45 @@ namespace omnical {
 
 namespace {
 
+// One AprilTag detector per thread and family, made on first use: adding a family builds
+// its quick-decode table (tens of MB for tag36h11), which cost more than detecting the
+// tags of a virtual view when it was made for every call.
+class TagDetector {
+ public:
+  explicit TagDetector(bool tag36h11) : tag36h11_(tag36h11) {
+    family_ = tag36h11 ? tag36h11_create() : tagStandard41h12_create();
+    detector_ = apriltag_detector_create();
+    apriltag_detector_add_family(detector_, family_);
+    detector_->quad_decimate = 1.0f;  // full resolution: corners are what calibration needs
+    detector_->nthreads = 1;          // images are processed in parallel instead
+    detector_->refine_edges = true;
+  }
+  ~TagDetector() {
+    apriltag_detector_destroy(detector_);
+    if (tag36h11_) tag36h11_destroy(family_); else tagStandard41h12_destroy(family_);
+  }
+  TagDetector(const TagDetector&) = delete;
+  TagDetector& operator=(const TagDetector&) = delete;
+
+  static apriltag_detector_t* ForThisThread(const std::string& family) {
+    const bool tag36h11 = family == "tag36h11";
+    thread_local std::unique_ptr<TagDetector> detectors[2];
+    std::unique_ptr<TagDetector>& slot = detectors[tag36h11 ? 0 : 1];
+    if (!slot) slot = std::make_unique<TagDetector>(tag36h11);
+    return slot->detector_;
+  }
+
+ private:
+  bool tag36h11_;
+  apriltag_family_t* family_;
+  apriltag_detector_t* detector_;
+};
+
 // AprilTag 3 over an image (corners in its pixel-centre coordinates): the target's ids
 // only, and an id decoded twice dropped altogether (which copy is the tag is unknown).
 std::map<int, std::array<Eigen::Vector2d, 4>> DetectTags(const CalibrationTarget& target, const cv::Mat& image,
                                                          DetectionStats* stats) {
-  apriltag_family_t* family = target.family() == "tag36h11" ? tag36h11_create() : tagStandard41h12_create();
-  apriltag_detector_t* detector = apriltag_detector_create();
-  apriltag_detector_add_family(detector, family);
-  detector->quad_decimate = 1.0f;  // full resolution: corners are what calibration needs
-  detector->nthreads = 1;          // images are processed in parallel instead
-  detector->refine_edges = true;
+  apriltag_detector_t* detector = TagDetector::ForThisThread(target.family());
   cv::Mat continuous = image.isContinuous() ? image : image.clone();
   image_u8_t frame{continuous.cols, continuous.rows, static_cast<int32_t>(continuous.step), continuous.data};
   zarray_t* detections = apriltag_detector_detect(detector, &frame);
@@ -58,8 +88,6 @@ std::map<int, std::array<Eigen::Vector2d, 4>> DetectTags(const CalibrationTarget
     if (count > 1) tags.erase(id), ++local.duplicates;
   local.tags = static_cast<int>(tags.size());
   apriltag_detections_destroy(detections);
-  apriltag_detector_destroy(detector);
-  if (target.family() == "tag36h11") tag36h11_destroy(family); else tagStandard41h12_destroy(family);
   if (stats) *stats = local;
   return tags;
 }

@@ -1,7 +1,7 @@
 // A virtual perspective view resampled from the omni image: a pinhole camera at a point
 // of the sensor (its reference viewpoint, or a ray's own origin) looking along a chosen
-// frame. Each view pixel holds the exact projection of the point along its ray at the
-// view's depth, so
+// frame. Each view pixel holds the projection of the point along its ray at the view's
+// depth (exact on a grid of nodes, within 0.01 px between them: model/grid_table.h), so
 // anything found in the view maps back to omni pixels through the same table, whatever
 // the error of the sensor the view was built with.
 #pragma once

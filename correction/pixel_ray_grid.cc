@@ -1,6 +1,6 @@
 #include "correction/pixel_ray_grid.h"
 
-#include "correction/parallel_rows.h"
+#include "model/parallel_rows.h"
 
 #include <algorithm>
 #include <cmath>

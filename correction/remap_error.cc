@@ -4,7 +4,7 @@
 #include <cmath>
 #include <vector>
 
-#include "correction/parallel_rows.h"
+#include "model/parallel_rows.h"
 
 namespace omnical {
 

@@ -1,6 +1,7 @@
 #include "correction/remap_table.h"
 
-#include "correction/parallel_rows.h"
+#include "model/grid_table.h"
+#include "model/parallel_rows.h"
 
 #include <algorithm>
 #include <array>
@@ -77,14 +78,8 @@ long ProjectColumnsOfRow(const Sensor& sensor, const RemapSettings& settings, in
   return valid;
 }
 
-// Weights of the cubic through nodes at -1, 0, 1, 2 (in steps) evaluated at t in [0, 1].
-std::array<double, 4> CubicWeights(double t) {
-  return {-t * (t - 1.0) * (t - 2.0) / 6.0, (t + 1.0) * (t - 1.0) * (t - 2.0) / 2.0,
-          -(t + 1.0) * t * (t - 2.0) / 2.0, (t + 1.0) * t * (t - 1.0) / 6.0};
-}
-
 // Output pixels per kNodeSpacingDeg at the screen's centre (the larger of its two
-// directions' angles per pixel), at least 2.
+// directions' angles per pixel).
 int AutomaticStep(const VirtualScreen& screen) {
   const double cx = 0.5 * (screen.width_px - 1), cy = 0.5 * (screen.height_px - 1);
   double pixel_rad = 0.0;
@@ -93,102 +88,26 @@ int AutomaticStep(const VirtualScreen& screen) {
     if (screen.Direction(cx - offset.x(), cy - offset.y(), &a) && screen.Direction(cx + offset.x(), cy + offset.y(), &b))
       pixel_rad = std::max(pixel_rad, std::acos(std::clamp(a.dot(b), -1.0, 1.0)));
   }
-  if (!(pixel_rad > 0.0)) return 2;
-  return std::clamp(static_cast<int>(kNodeSpacingDeg * kPi / 180.0 / pixel_rad), 2, 64);
+  return NodeStepPx(pixel_rad);
 }
 
-// The interpolated path (see remap_table.h). Node (i, j) sits at output point
-// ((i - 1) step, (j - 1) step): one node beyond each side, so that the pixel u in cell
-// a = u / step has the nodes a .. a + 3 around it.
+// The interpolated path (model/grid_table.h).
 void FillByInterpolation(const Sensor& sensor, const RemapSettings& settings, ProgressReporter& progress,
                          RemapTable* table) {
-  const int step = settings.interpolation_step_px > 0 ? settings.interpolation_step_px : AutomaticStep(settings.screen);
-  const int width = table->width, height = table->height;
-  const int node_cols = (width - 1) / step + 4, node_rows = (height - 1) / step + 4;
-  const int cell_cols = node_cols - 3, cell_rows = node_rows - 3;
-  // Each node row, and its cubic along the row at every output column (NaN where a node
-  // is missing), so that a pixel needs only the cubic across 4 of these rows.
-  std::vector<double> nodes_x(static_cast<size_t>(node_cols) * node_rows), nodes_y(nodes_x.size());
-  std::vector<double> along_x(static_cast<size_t>(width) * node_rows), along_y(along_x.size());
-  std::vector<std::array<double, 4>> column_weights(width);
-  for (int u = 0; u < width; ++u) column_weights[u] = CubicWeights(double(u % step) / step);
-  ParallelRows(node_rows, settings.threads, [&](int j) {
-    Eigen::Matrix2Xd output_points(2, node_cols);
-    for (int i = 0; i < node_cols; ++i) output_points.col(i) = Eigen::Vector2d((i - 1.0) * step, (j - 1.0) * step);
-    const Eigen::Matrix2Xd pixels = ProjectOutputPoints(sensor, settings, output_points);
-    double* node_x = &nodes_x[static_cast<size_t>(j) * node_cols];
-    double* node_y = &nodes_y[static_cast<size_t>(j) * node_cols];
-    for (int i = 0; i < node_cols; ++i) node_x[i] = pixels(0, i), node_y[i] = pixels(1, i);
-    for (int u = 0; u < width; ++u) {
-      const int a = u / step;
-      const std::array<double, 4>& w = column_weights[u];
-      along_x[static_cast<size_t>(j) * width + u] = w[0] * node_x[a] + w[1] * node_x[a + 1] + w[2] * node_x[a + 2] + w[3] * node_x[a + 3];
-      along_y[static_cast<size_t>(j) * width + u] = w[0] * node_y[a] + w[1] * node_y[a + 1] + w[2] * node_y[a + 2] + w[3] * node_y[a + 3];
-    }
-  });
-
-  // Cells: interpolated only with all 16 nodes and a centre within the check tolerance.
-  std::vector<char> interpolated(static_cast<size_t>(cell_cols) * cell_rows, 0);
-  std::vector<double> worst_check(cell_rows, 0.0);
-  ParallelRows(cell_rows, settings.threads, [&](int b) {
-    const std::array<double, 4> w = CubicWeights(0.5);
-    Eigen::Matrix2Xd centres(2, cell_cols), guesses(2, cell_cols);
-    for (int a = 0; a < cell_cols; ++a) {
-      centres.col(a) = Eigen::Vector2d((a + 0.5) * step, (b + 0.5) * step);
-      Eigen::Vector2d guess = Eigen::Vector2d::Zero();
-      for (int k = 0; k < 4; ++k)
-        for (int l = 0; l < 4; ++l) {
-          const size_t node = static_cast<size_t>(b + k) * node_cols + a + l;
-          guess += w[k] * w[l] * Eigen::Vector2d(nodes_x[node], nodes_y[node]);
-        }
-      guesses.col(a) = guess;  // NaN if a node is missing
-    }
-    const Eigen::Matrix2Xd exact = ProjectOutputPoints(sensor, settings, centres);
-    for (int a = 0; a < cell_cols; ++a) {
-      const double miss = (guesses.col(a) - exact.col(a)).cwiseAbs().maxCoeff();  // NaN fails below
-      if (miss < kCellCheckTolerancePx) {
-        interpolated[static_cast<size_t>(b) * cell_cols + a] = 1;
-        worst_check[b] = std::max(worst_check[b], miss);
-      }
-    }
-  });
-
-  std::atomic<long> valid{0}, exact_pixels{0};
+  GridTableRequest request;
+  request.width = table->width;
+  request.height = table->height;
+  request.step_px = settings.interpolation_step_px > 0 ? settings.interpolation_step_px : AutomaticStep(settings.screen);
+  request.threads = settings.threads;
+  request.project = [&](const Eigen::Matrix2Xd& output_points) { return ProjectOutputPoints(sensor, settings, output_points); };
   const ImageArea image(sensor);
-  ParallelRows(height, settings.threads, [&](int v) {
-    if (progress.cancelled()) return;
-    const int b = v / step;
-    const std::array<double, 4> w = CubicWeights(double(v % step) / step);
-    const size_t row0 = static_cast<size_t>(b) * width;
-    const size_t stride = width;
-    std::vector<int> exact_columns;
-    long row_valid = 0;
-    for (int u = 0; u < width; ++u) {
-      if (!interpolated[static_cast<size_t>(b) * cell_cols + u / step]) {
-        exact_columns.push_back(u);
-        continue;
-      }
-      const size_t k = row0 + u;
-      const double x = w[0] * along_x[k] + w[1] * along_x[k + stride] + w[2] * along_x[k + 2 * stride] + w[3] * along_x[k + 3 * stride];
-      const double y = w[0] * along_y[k] + w[1] * along_y[k + stride] + w[2] * along_y[k + 2 * stride] + w[3] * along_y[k + 3 * stride];
-      if (!image.Contains(x, y)) continue;
-      const size_t i = static_cast<size_t>(v) * width + u;
-      table->map_x[i] = static_cast<float>(x);
-      table->map_y[i] = static_cast<float>(y);
-      ++row_valid;
-    }
-    if (!exact_columns.empty()) {
-      const long projected = ProjectColumnsOfRow(sensor, settings, v, exact_columns, table);
-      row_valid += projected;
-      exact_pixels += projected;
-    }
-    valid += row_valid;
-    progress.Advance();
-  });
-  table->valid_pixels = valid;
-  table->exact_pixels = exact_pixels;
-  table->interpolation_step_px = step;
-  table->worst_cell_check_px = *std::max_element(worst_check.begin(), worst_check.end());
+  request.keep = [&](double x, double y) { return image.Contains(x, y); };
+  request.row_done = [&]() { return progress.Advance(); };
+  const GridTableFill fill = FillGridTable(request, table->map_x.data(), table->map_y.data());
+  table->valid_pixels = fill.valid_pixels;
+  table->exact_pixels = fill.exact_pixels;
+  table->interpolation_step_px = request.step_px;
+  table->worst_cell_check_px = fill.worst_cell_check_px;
 }
 
 }  // namespace

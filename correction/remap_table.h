@@ -8,20 +8,16 @@
 // azimuths and every column follows as u = cu + au cos(phi), v = cv + av sin(phi) (exact
 // for the lens models, which scale x and y separately about a centre; tested against the
 // per-pixel path to 1e-6 px). Everything else (tilted or decentred sensors, perspective
-// and equiangular screens, planes) is projected exactly on a grid of nodes every
-// `interpolation_step_px` output pixels and interpolated between them with 4-point
-// Lagrange cubics in both directions (error ~h^4; nodes ~kNodeSpacingDeg apart). Each grid cell is checked at its centre
-// against an exact projection; a cell that misses by more than kCellCheckTolerancePx, or
-// touches a node without a pixel (field edges, the image border), is projected pixel by
-// pixel. Measured against the per-pixel tables (tests/remap_test.cc): below 0.01 px
-// everywhere on every shipped misaligned sensor, screen and surface. Rows of nodes, cells
-// and pixels spread over threads.
+// and equiangular screens, planes) is interpolated between exact nodes about
+// kNodeSpacingDeg apart, checked cell by cell (model/grid_table.h): below 0.01 px
+// everywhere on every shipped misaligned sensor, screen and surface (tests/remap_test.cc).
 #pragma once
 
 #include <vector>
 
 #include "correction/object_surface.h"
 #include "correction/virtual_screen.h"
+#include "model/grid_table.h"
 #include "model/progress.h"
 #include "model/sensor.h"
 
@@ -40,16 +36,6 @@ struct RemapTable {
   long exact_pixels = 0;
   double worst_cell_check_px = 0.0;
 };
-
-// Automatic node spacing: on the test sensors (rim ~480 px), 2 deg cells pass the check
-// almost everywhere the field is smooth, 4 deg cells fail in ~10-50 % of the field, 8 deg
-// in most of it (measured while writing tests/remap_test.cc).
-constexpr double kNodeSpacingDeg = 2.0;
-
-// A cell whose centre misses the exact pixel by more is projected pixel by pixel; a
-// third of the 0.01 px the tables promise, because the centre is not always the worst
-// point of a cell (tests/remap_test.cc measures the whole tables).
-constexpr double kCellCheckTolerancePx = 0.003;
 
 struct RemapSettings {
   VirtualScreen screen;

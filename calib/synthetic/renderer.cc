@@ -1,6 +1,6 @@
 #include "calib/synthetic/renderer.h"
 
-#include "correction/parallel_rows.h"
+#include "model/parallel_rows.h"
 
 #include <opencv2/imgproc.hpp>
 

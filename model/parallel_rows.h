@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <exception>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -12,17 +14,30 @@
 
 namespace omnical {
 
-// Calls row(v) once for every v in [0, rows), from `threads` threads (at least one).
+// Calls row(v) once for every v in [0, rows), from `threads` threads (at least one). A
+// row that throws stops the rows not yet started; the first exception is rethrown here
+// once every thread has finished (thrown on a worker thread it would end the process).
 template <typename RowFunction>
 void ParallelRows(int rows, int threads, const RowFunction& row) {
   std::atomic<int> next{0};
+  std::exception_ptr thrown;
+  std::mutex thrown_mutex;
   auto work = [&]() {
-    for (int v = next++; v < rows; v = next++) row(v);
+    for (int v = next++; v < rows; v = next++) {
+      try {
+        row(v);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(thrown_mutex);
+        if (!thrown) thrown = std::current_exception();
+        next = rows;
+      }
+    }
   };
   std::vector<std::thread> pool;
   StartWorkers(std::min(threads, rows), work, &pool);
   work();
   for (std::thread& thread : pool) thread.join();
+  if (thrown) std::rethrow_exception(thrown);
 }
 
 }  // namespace omnical
