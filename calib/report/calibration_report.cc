@@ -12,6 +12,7 @@
 #include "calib/report/plot.h"
 #include "calib/report/projection_diff_figure.h"
 #include "model/io/atomic_write.h"
+#include "model/parallel_rows.h"
 
 namespace omnical {
 namespace {
@@ -42,7 +43,7 @@ void WritePredictedErrorMap(const std::string& path, const Sensor& sensor, const
 }
 
 void WriteReport(const std::filesystem::path& dir, const DetectionSet& detections, const FitResult& fit,
-                 const std::vector<NamedImage>& images) {
+                 const std::vector<NamedImage>& images, int threads) {
   CreateOutputDirectory(dir);
   double worst = 0.0;
   std::vector<double> magnitudes;
@@ -52,7 +53,12 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
   // Residual vectors on each image, scaled so the largest is ~40 px long.
   const double scale = worst > 0.0 ? std::pow(10.0, std::floor(std::log10(40.0 / worst))) : 1.0;
   cv::Mat coverage(detections.image_height_px, detections.image_width_px, CV_8UC3, cv::Scalar(30, 30, 30));
-  for (size_t v = 0; v < detections.images.size(); ++v) {
+  for (size_t v = 0; v < detections.images.size(); ++v)
+    for (const CornerObservation& corner : detections.images[v].corners)
+      cv::circle(coverage, cv::Point2d(corner.pixel.x(), corner.pixel.y()), 2, SeriesColor(static_cast<int>(v)), cv::FILLED);
+  // One whole camera frame per view: encoding them is most of the report's time, so the
+  // views spread over threads.
+  ParallelRows(static_cast<int>(detections.images.size()), threads, [&](int v) {
     const ImageDetections& image = detections.images[v];
     cv::Mat picture;
     if (images.empty()) {
@@ -64,7 +70,6 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
     if (picture.empty()) picture = cv::Mat(detections.image_height_px, detections.image_width_px, CV_8UC3, cv::Scalar(40, 40, 40));
     for (size_t i = 0; i < image.corners.size(); ++i) {
       const cv::Point2d p(image.corners[i].pixel.x(), image.corners[i].pixel.y());
-      cv::circle(coverage, p, 2, SeriesColor(static_cast<int>(v)), cv::FILLED);
       const Eigen::Vector2d& r = fit.residuals_px[v][i];
       if (!std::isfinite(r.x())) {
         cv::drawMarker(picture, p, cv::Scalar(0, 0, 255), cv::MARKER_TILTED_CROSS, 8, 1);  // dropped
@@ -78,7 +83,7 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
                   fit.per_view_rms_px[v]);
     cv::putText(picture, legend, {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
     WritePng((dir / ("residuals_view" + std::to_string(v) + ".png")).string(), picture);
-  }
+  });
   cv::putText(coverage, "detected corners, one colour per view", {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.6,
               cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   WritePng((dir / "coverage.png").string(), coverage);
@@ -150,7 +155,7 @@ void WriteHoldoutFigure(const std::string& path, const CalibrationResult& result
 void WriteCalibrationReport(const std::string& dir, const CalibrationResult& result, const CalibrationOptions& options,
                             const std::vector<NamedImage>& images) {
   const std::filesystem::path path(dir);
-  WriteReport(path, result.views, result.fit, images);
+  WriteReport(path, result.views, result.fit, images, options.threads);
   if (const auto& cross = result.record.cross_validation)
     WriteProjectionDiffFigure((path / "cross_validation.png").string(), cross->diff, result.sensor.image_width_px(),
                               result.sensor.image_height_px(), "two halves of the views, each calibrated: half 2 against half 1");
