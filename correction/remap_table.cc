@@ -9,12 +9,6 @@
 #include <cmath>
 
 namespace omnical {
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-}  // namespace
-
 double InfinityDistanceMm(const Sensor& sensor) { return 1e7 * sensor.rim_radius_mm(); }
 
 bool RemapObjectPoint(const Sensor& sensor, const RemapSettings& settings, double col, double row,
@@ -159,7 +153,7 @@ RemapTable BuildRemapTable(const Sensor& sensor, const RemapSettings& settings, 
       std::vector<ProjectionStatus> statuses;
       bool ok = true;
       for (int k = 0; k < 4 && ok; ++k) {
-        const double phi = 0.5 * kPi * k;
+        const double phi = 0.5 * M_PI * k;
         const Eigen::Vector3d turned(horizontal * std::cos(phi), horizontal * std::sin(phi), d.z());
         Eigen::Vector3d point;
         ok = settings.surface.PointAlong(Eigen::Vector3d(0.0, 0.0, settings.v0_mm), turned, InfinityDistanceMm(sensor), &point);

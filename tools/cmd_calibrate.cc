@@ -20,7 +20,7 @@
 namespace omnical::cli {
 namespace {
 
-struct Options {
+struct CalibrateFlags {
   std::string target_path, detections_path, images, sensor_path, out_dir, fix, tolerance, knots;
   CalibrationOptions library;
 };
@@ -33,7 +33,7 @@ const FlagTable kFlags = {{"fixed", "--fix"}, {"robust_loss_px", "--loss-px"}, {
                           {"holdout_views", "--holdout"}, {"holdout", "--holdout"}, {"cross_validate", "--cross-validate"},
                           {"cross_validation_distance_mm", "--cross-validate-distance-mm"}, {"knots", "--knots"}};
 
-void Run(Options options, const Context& context) {
+void RunCalibrate(CalibrateFlags options, const Context& context) {
   CalibrationInput input;
   input.target = CalibrationTarget::FromYaml(options.target_path);
   input.target_name = options.target_path;
@@ -75,7 +75,7 @@ void Run(Options options, const Context& context) {
 Command CalibrateCommand() {
   return {"calibrate", "Bundle fit of the non-central model from images or detections (and a guess, or the rim circle)",
           [](CLI::App& sub, const Context& context) -> CommandAction {
-            auto options = std::make_shared<Options>();
+            auto options = std::make_shared<CalibrateFlags>();
             CalibrationOptions& library = options->library;
             sub.add_option("--target", options->target_path, "Target spec (YAML, Kalibr keys)")->required();
             sub.add_option("--images", options->images,
@@ -135,7 +135,7 @@ Command CalibrateCommand() {
                 ->check(kPositive);
             sub.add_flag("--leave-one-out", library.leave_one_out,
                          "Also fit without each image in turn; calibration.json gets each parameter's spread");
-            return [options, &context]() { Run(*options, context); };
+            return [options, &context]() { RunCalibrate(*options, context); };
           }};
 }
 

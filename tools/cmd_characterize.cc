@@ -23,7 +23,7 @@ struct Flags {
   CharacterizeOptions job;
 };
 
-void Run(const Flags& flags, const Context& context) {
+void RunCharacterize(const Flags& flags, const Context& context) {
   const Sensor sensor = LoadSensorYaml(flags.sensor_path);
   const FlagTable names = {{"lens_focal_mm", "--lens-f"}, {"focus_mm", "--focus-mm"}, {"f_number", "--f-number"},
                             {"pixel_um", "--pixel-um"},    {"near_n", "--near-n"},     {"samples", "--samples"}};
@@ -74,7 +74,7 @@ Command CharacterizeCommand() {
             sub.add_option("--samples", o.samples, "Samples over the mirror radius")
                 ->check(CLI::Range(10, 100000))
                 ->capture_default_str();
-            return [flags, &context]() { Run(*flags, context); };
+            return [flags, &context]() { RunCharacterize(*flags, context); };
           }};
 }
 

@@ -14,7 +14,7 @@
 namespace omnical::cli {
 namespace {
 
-struct Options {
+struct DiffFlags {
   std::string a, b, field_path, out_dir;
   double distance_mm = 2000.0, step_px = 16.0;
   bool no_align = false;
@@ -26,7 +26,7 @@ std::string SensorFileOf(const std::string& path) {
   return std::filesystem::is_directory(given) ? (given / "sensor.yaml").string() : path;
 }
 
-void Run(const Options& options, const Context& context) {
+void RunDiff(const DiffFlags& options, const Context& context) {
   const Sensor a = LoadSensorYaml(SensorFileOf(options.a));
   const Sensor b = LoadSensorYaml(SensorFileOf(options.b));
   if (a.image_width_px() != b.image_width_px() || a.image_height_px() != b.image_height_px())
@@ -65,7 +65,7 @@ void Run(const Options& options, const Context& context) {
 Command DiffCommand() {
   return {"diff", "Compare two calibrations: their projection difference at a distance after the best rigid alignment",
           [](CLI::App& sub, const Context& context) -> CommandAction {
-            auto options = std::make_shared<Options>();
+            auto options = std::make_shared<DiffFlags>();
             sub.add_option("a", options->a, "Reference calibration: a sensor file or calibrate's --out directory")->required();
             sub.add_option("b", options->b, "The other calibration, the same way")->required();
             sub.add_option("--distance-mm", options->distance_mm,
@@ -78,7 +78,7 @@ Command DiffCommand() {
                 ->check(CLI::Range(1.0, 1000.0))->capture_default_str();
             sub.add_flag("--no-align", options->no_align, "Compare without the rigid alignment");
             sub.add_option("--out", options->out_dir, "Output directory for diff.json and diff.png");
-            return [options, &context]() { Run(*options, context); };
+            return [options, &context]() { RunDiff(*options, context); };
           }};
 }
 

@@ -15,12 +15,12 @@
 namespace omnical::cli {
 namespace {
 
-struct Options {
+struct ExportCentralFlags {
   std::string sensor_path, model, out_dir;
   CentralExportOptions job;
 };
 
-void Run(Options& options, const Context& context) {
+void RunExportCentral(ExportCentralFlags& options, const Context& context) {
   const Sensor sensor = LoadSensorYaml(options.sensor_path);
   options.job.model = *ParseCentralModelKind(options.model);
   options.job.progress = TerminalProgress(context);
@@ -39,7 +39,7 @@ void Run(Options& options, const Context& context) {
 Command ExportCentralCommand() {
   return {"export-central", "Best-fit central model (Mei for cv::omnidir, or OCamCalib) with its error over the field",
           [](CLI::App& sub, const Context& context) -> CommandAction {
-            auto options = std::make_shared<Options>();
+            auto options = std::make_shared<ExportCentralFlags>();
             CentralExportOptions& job = options->job;
             sub.add_option("--sensor", options->sensor_path, "Sensor file (YAML)")->required();
             sub.add_option("--model", options->model, "mei (cv::omnidir YAML) or ocamcalib (calib_results.txt)")
@@ -52,7 +52,7 @@ Command ExportCentralCommand() {
                                               "default: the one minimising the worst error at the distance");
             sub.add_option("--step-px", job.step_px, "Field sampling grid, omni px")->capture_default_str();
             sub.add_option("--out", options->out_dir, "Output directory")->required();
-            return [options, &context]() { Run(*options, context); };
+            return [options, &context]() { RunExportCentral(*options, context); };
           }};
 }
 

@@ -17,12 +17,12 @@
 namespace omnical::cli {
 namespace {
 
-struct Options {
+struct ParallaxFlags {
   std::string sensor_path, out_dir, maps_dir;
   ParallaxOptions job;
 };
 
-void RunForMaps(const Options& options, const Context& context) {
+void RunForMaps(const ParallaxFlags& options, const Context& context) {
   const MapsDescription maps = ReadMapsDescription(options.maps_dir);
   const Sensor sensor = options.sensor_path.empty() ? SensorOfMaps(maps) : LoadSensorYaml(options.sensor_path);
   MapsErrorOptions job;
@@ -35,7 +35,7 @@ void RunForMaps(const Options& options, const Context& context) {
                 result.made_for.c_str(), result.errors.back().stats.max_px, result.MaxPxAtN(2.0), options.out_dir.c_str());
 }
 
-void Run(Options& options, const Context& context) {
+void RunParallax(ParallaxFlags& options, const Context& context) {
   if (!options.maps_dir.empty()) return RunForMaps(options, context);
   if (options.sensor_path.empty()) throw InputError("parallax: --sensor is required (or --maps DIR)");
   const Sensor sensor = LoadSensorYaml(options.sensor_path);
@@ -55,7 +55,7 @@ void Run(Options& options, const Context& context) {
 Command ParallaxCommand() {
   return {"parallax", "Viewpoint-distribution error (seed Eq. 23) for near objects: curve, error map, best V0",
           [](CLI::App& sub, const Context& context) -> CommandAction {
-            auto options = std::make_shared<Options>();
+            auto options = std::make_shared<ParallaxFlags>();
             ParallaxOptions& job = options->job;
             sub.add_option("--sensor", options->sensor_path, "Sensor file (YAML); with --maps, instead of the maps' own");
             auto* maps = sub.add_option("--maps", options->maps_dir,
@@ -71,7 +71,7 @@ Command ParallaxCommand() {
             sub.callback([n, d, maps]() {
               if (maps->count() == 0 && n->count() == 0 && d->count() == 0) throw CLI::RequiredError("--n or --distance-mm");
             });
-            return [options, &context]() { Run(*options, context); };
+            return [options, &context]() { RunParallax(*options, context); };
           }};
 }
 

@@ -18,7 +18,7 @@
 namespace omnical::cli {
 namespace {
 
-struct Options {
+struct RemapFlags {
   std::string sensor_path, out_dir;
   std::vector<std::string> formats{"opencv"};
   RemapOptions job;
@@ -44,7 +44,7 @@ void PrintSummary(const RemapResult& result, const MapFiles& files, const std::s
   if (files.ffmpeg) std::printf("  ffmpeg: %s\n", files.ffmpeg_command.c_str());
 }
 
-void Run(Options& options, const Context& context) {
+void RunRemap(RemapFlags& options, const Context& context) {
   const Sensor sensor = LoadSensorYaml(options.sensor_path);
   options.job.progress = TerminalProgress(context);
   const RemapResult result = NamingFlags(ViewFlags(), [&] { return BuildRemap(sensor, options.job); });
@@ -62,7 +62,7 @@ void Run(Options& options, const Context& context) {
 Command RemapCommand() {
   return {"remap", "Remap tables to a virtual screen (panorama, lonlat, perspective, equiangular), exact at a known distance",
           [](CLI::App& sub, const Context& context) -> CommandAction {
-            auto options = std::make_shared<Options>();
+            auto options = std::make_shared<RemapFlags>();
             sub.add_option("--sensor", options->sensor_path, "Sensor file (YAML)")->required();
             sub.add_option("--out", options->out_dir, "Output directory")->required();
             sub.add_option("--format", options->formats, "Formats: opencv, ffmpeg, npy (comma separated)")
@@ -70,7 +70,7 @@ Command RemapCommand() {
                 ->check(CLI::IsMember({"opencv", "ffmpeg", "npy"}))
                 ->capture_default_str();
             AddViewOptions(sub, &options->job.view, true);
-            return [options, &context]() { Run(*options, context); };
+            return [options, &context]() { RunRemap(*options, context); };
           }};
 }
 

@@ -19,13 +19,13 @@
 namespace omnical::cli {
 namespace {
 
-struct Options {
+struct UnwarpFlags {
   std::string sensor_path, maps_dir, input, out, interpolation = "linear";
   ViewRequest view;
   bool view_given = false;
 };
 
-Unwarper MakeUnwarper(const Options& options, const ProgressCallback& progress) {
+Unwarper MakeUnwarper(const UnwarpFlags& options, const ProgressCallback& progress) {
   if (options.maps_dir.empty() == !options.view_given)
     throw InputError("unwarp: give either --maps DIR or view options (--view, --distance-mm | --n | --infinity, ...)");
   const Interpolation interpolation = *ParseInterpolation(options.interpolation);
@@ -40,7 +40,7 @@ Unwarper MakeUnwarper(const Options& options, const ProgressCallback& progress) 
 }
 
 // The video through the unwarper into options.out (MJPG .avi or mp4v .mp4), atomically.
-long UnwarpVideo(const Unwarper& unwarper, const Options& options, const ProgressCallback& progress) {
+long UnwarpVideo(const Unwarper& unwarper, const UnwarpFlags& options, const ProgressCallback& progress) {
   cv::VideoCapture capture(options.input);
   if (!capture.isOpened()) throw InputError(InputMessage(options.input, "", "cannot be opened as a video"));
   const std::string extension = LowerExtension(options.out);
@@ -68,7 +68,7 @@ long UnwarpVideo(const Unwarper& unwarper, const Options& options, const Progres
   return frames;
 }
 
-void Run(const Options& options, const Context& context) {
+void RunUnwarp(const UnwarpFlags& options, const Context& context) {
   const ProgressCallback progress = TerminalProgress(context);
   const Unwarper unwarper = MakeUnwarper(options, progress);
   const std::filesystem::path out_dir = std::filesystem::path(options.out).parent_path();
@@ -94,7 +94,7 @@ void Run(const Options& options, const Context& context) {
 Command UnwarpCommand() {
   return {"unwarp", "Unwarp an omni image or video to a virtual screen (--maps DIR from `remap`, or view options)",
           [](CLI::App& sub, const Context& context) -> CommandAction {
-            auto options = std::make_shared<Options>();
+            auto options = std::make_shared<UnwarpFlags>();
             sub.add_option("--sensor", options->sensor_path, "Sensor file (YAML); optional with --maps");
             sub.add_option("--maps", options->maps_dir, "Directory written by `omnical remap` (maps.json + maps.yml.gz)");
             sub.add_option("--input", options->input, "Omni image or video (.mp4, .avi, .mkv, .mov, ...)")->required();
@@ -105,7 +105,7 @@ Command UnwarpCommand() {
             AddViewOptions(sub, &options->view, false);
             return [options, &context, &sub]() {
               options->view_given = AnyViewOptionGiven(sub);
-              Run(*options, context);
+              RunUnwarp(*options, context);
             };
           }};
 }

@@ -9,7 +9,7 @@
 namespace omnical {
 namespace {
 
-constexpr double kDeg = 180.0 / M_PI;
+constexpr double kDegPerRad = 180.0 / M_PI;
 
 bool Positive(double value) { return std::isfinite(value) && value > 0.0; }
 
@@ -25,8 +25,8 @@ std::string CharacterizeOptions::Check() const {
   return {};
 }
 
-double CharacterizeResult::rim_omega_deg() const { return field.back().ray.omega_rad * kDeg; }
-double CharacterizeResult::rim_theta_deg() const { return field.back().ray.theta_rad * kDeg; }
+double CharacterizeResult::rim_omega_deg() const { return field.back().ray.omega_rad * kDegPerRad; }
+double CharacterizeResult::rim_theta_deg() const { return field.back().ray.theta_rad * kDegPerRad; }
 
 CharacterizeResult Characterize(const Sensor& sensor, const CharacterizeOptions& options) {
   if (const std::string why = options.Check(); !why.empty()) throw InputError(why);

@@ -11,7 +11,7 @@
 namespace omnical {
 namespace {
 
-constexpr double kDeg = 180.0 / M_PI;
+constexpr double kDesignDegPerRad = 180.0 / M_PI;
 
 void WriteJson(const nlohmann::json& j, const std::string& path) {
   WriteFileAtomically(path, [&](std::ostream& out) { out << j.dump(2) << '\n'; });
@@ -144,8 +144,8 @@ void WriteCharacteristicsCsv(const CharacterizeResult& r, const std::string& pat
       const FieldSample& f = r.field[i];
       const BlurSpot& b = r.blur[i];
       const AxialRayQuantities& q = f.ray;
-      out << q.x_mm << ',' << q.z_mm << ',' << q.omega_rad * kDeg << ',' << q.theta_rad * kDeg << ','
-          << q.beta_rad * kDeg << ',' << q.gamma_rad * kDeg << ',' << q.viewpoint_z_mm << ',' << f.h_px << ','
+      out << q.x_mm << ',' << q.z_mm << ',' << q.omega_rad * kDesignDegPerRad << ',' << q.theta_rad * kDesignDegPerRad << ','
+          << q.beta_rad * kDesignDegPerRad << ',' << q.gamma_rad * kDesignDegPerRad << ',' << q.viewpoint_z_mm << ',' << f.h_px << ','
           << f.delta_h_px << ',' << f.delta_w_px << ',' << f.delta_s_px2 << ',' << f.aspect_ratio << ','
           << f.tangential_curvature_per_mm << ',' << f.sagittal_curvature_per_mm << ',' << f.tangential_far.x_mm << ','
           << f.tangential_far.z_mm << ',' << f.sagittal_far.x_mm << ',' << f.sagittal_far.z_mm << ','
