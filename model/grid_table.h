@@ -3,9 +3,10 @@
 // them with 4-point Lagrange cubics in both directions (error ~h^4). Each grid cell is
 // checked at its centre against an exact projection; a cell that misses by more than
 // kCellCheckTolerancePx, or touches a node without a pixel (field edges, the image
-// border), is projected pixel by pixel. Measured against per-pixel tables
-// (tests/remap_test.cc, tests/virtual_view_test.cc): below 0.01 px everywhere on every
-// shipped misaligned sensor. Rows of nodes, cells and pixels spread over threads.
+// border), is projected pixel by pixel. Measured against per-pixel tables on every
+// misaligned test sensor (tests/remap_test.cc, and the VirtualView test in
+// tests/detect_test.cc): below 0.01 px everywhere. Rows of nodes, cells and pixels spread
+// over threads.
 #pragma once
 
 #include <Eigen/Core>
