@@ -4,7 +4,6 @@
 #include "model/parallel_rows.h"
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cmath>
 
