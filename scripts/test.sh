@@ -11,7 +11,10 @@
 # (122 s) and cli.interrupt_leaves_previous_outputs (157 s), and the fits of
 # calibration_trust_test (5-150 s each in Release: its Monte Carlo runs 30 fits; the cheap
 # ones, rim and tolerance checks, stay) and BoardScale.RefusesADistantGiant (296 s there;
-# RealImages runs the board-size check under the sanitizers). The Python module and its
+# RealImages runs the board-size check under the sanitizers). One test program is not
+# built there at all (tests/CMakeLists.txt): jet_derivatives_test, Jets against central
+# differences, 56 s to compile there; bundle_fit_harness_test's GradientChecker checks
+# the same Jets model by model. The Python module and its
 # pytest suite run in the Release pass only: an ASan-built extension cannot load into
 # Debian's uninstrumented interpreter (ASan must be the first library loaded), so the
 # sanitizer tree is configured with OMNICAL_PYTHON=OFF; the C++ code the module calls is

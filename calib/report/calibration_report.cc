@@ -26,12 +26,9 @@ void WritePredictedErrorMap(const std::string& path, const Sensor& sensor, const
   const double top = std::max(threshold_px, map.max_px);
   for (size_t k = 0; k < map.pixels.size(); ++k) {
     if (!std::isfinite(map.std_px[k])) continue;
-    cv::Mat level(1, 1, CV_8U, cv::Scalar(static_cast<int>(std::lround(255.0 * std::min(1.0, map.std_px[k] / top)))));
-    cv::Mat colour;
-    cv::applyColorMap(level, colour, cv::COLORMAP_VIRIDIS);
-    const cv::Vec3b c = colour.at<cv::Vec3b>(0, 0);
+    const cv::Scalar colour = ColourMapColour(cv::COLORMAP_VIRIDIS, std::min(1.0, map.std_px[k] / top));
     const cv::Point2d corner(map.pixels[k].x() - 0.5 * step_px, map.pixels[k].y() - 0.5 * step_px);
-    cv::rectangle(picture, cv::Rect2d(corner, cv::Size2d(step_px, step_px)), cv::Scalar(c[0], c[1], c[2]), cv::FILLED);
+    cv::rectangle(picture, cv::Rect2d(corner, cv::Size2d(step_px, step_px)), colour, cv::FILLED);
   }
   char text[200];
   std::snprintf(text, sizeof text, "predicted error at %s: median %.3f px, worst %.3f px", label.c_str(), map.median_px,

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <mutex>
 
 #include "model/io/atomic_write.h"
 #include "model/input_error.h"
@@ -164,6 +166,27 @@ cv::Mat TilePanels(const std::vector<cv::Mat>& panels, int columns) {
   return out;
 }
 
+cv::Scalar ColourMapColour(int colormap, double fraction) {
+  // One 256-entry table per colour map, made by OpenCV itself so colours match
+  // cv::applyColorMap exactly; figures may be drawn from several threads.
+  static std::mutex tables_mutex;
+  static std::map<int, cv::Mat> tables;
+  cv::Mat table;
+  {
+    std::lock_guard<std::mutex> lock(tables_mutex);
+    cv::Mat& entry = tables[colormap];
+    if (entry.empty()) {
+      cv::Mat ramp(256, 1, CV_8UC1);
+      for (int level = 0; level < 256; ++level) ramp.at<uchar>(level) = static_cast<uchar>(level);
+      cv::applyColorMap(ramp, entry, colormap);
+    }
+    table = entry;
+  }
+  const double clamped = std::isfinite(fraction) ? std::clamp(fraction, 0.0, 1.0) : 0.0;
+  const cv::Vec3b colour = table.at<cv::Vec3b>(static_cast<int>(std::lround(255.0 * clamped)));
+  return cv::Scalar(colour[0], colour[1], colour[2]);
+}
+
 cv::Mat RenderFalseColourMap(const cv::Mat& values, const std::string& title, const std::string& unit) {
   double lo = HUGE_VAL, hi = -HUGE_VAL;
   for (int r = 0; r < values.rows; ++r)
@@ -190,11 +213,9 @@ cv::Mat RenderFalseColourMap(const cv::Mat& values, const std::string& title, co
   colour.copyTo(out(cv::Rect(0, title_height, colour.cols, colour.rows)));
   PutText(out, title, {colour.cols / 2, 8}, 0.6, 1, 2);
   const int bar_top = title_height + 20, bar_height = colour.rows - 40, bar_x = colour.cols + 16;
-  for (int i = 0; i < bar_height; ++i) {
-    cv::Mat one(1, 1, CV_8UC1, cv::Scalar(255 - 255 * i / std::max(1, bar_height - 1))), c;
-    cv::applyColorMap(one, c, cv::COLORMAP_TURBO);
-    cv::line(out, {bar_x, bar_top + i}, {bar_x + 24, bar_top + i}, cv::Scalar(c.at<cv::Vec3b>(0, 0)), 1);
-  }
+  for (int i = 0; i < bar_height; ++i)
+    cv::line(out, {bar_x, bar_top + i}, {bar_x + 24, bar_top + i},
+             ColourMapColour(cv::COLORMAP_TURBO, 1.0 - double(i) / std::max(1, bar_height - 1)), 1);
   cv::rectangle(out, cv::Rect(bar_x, bar_top, 25, bar_height), kBlack, 1);
   const double step = NiceStep(hi - lo, 6);
   for (double t = std::ceil(lo / step) * step; t <= hi + 1e-9 * step; t += step) {
@@ -208,10 +229,15 @@ cv::Mat RenderFalseColourMap(const cv::Mat& values, const std::string& title, co
 
 void WritePng(const std::string& path, const cv::Mat& image) {
   std::vector<uchar> bytes;
-  // Small figures compress hard (they are committed under docs/); large images (report
-  // overlays of whole camera frames) fast.
-  const int level = image.total() > 1000000 ? 3 : 9;
-  if (!cv::imencode(".png", image, bytes, {cv::IMWRITE_PNG_COMPRESSION, level})) throw InputError(InputMessage(path, "", "cannot encode PNG"));
+  // Small figures compress hard (they are committed under docs/). Large images (report
+  // overlays of whole camera frames) take OpenCV's speed settings, which it applies only
+  // when no level is given: one row filter (SUB) and zlib level 1. Any explicit level
+  // also makes libpng try every filter on every row, which was most of `calibrate
+  // --detections` on the real dev set.
+  const bool large = image.total() > 500000;
+  const bool encoded = large ? cv::imencode(".png", image, bytes)
+                             : cv::imencode(".png", image, bytes, {cv::IMWRITE_PNG_COMPRESSION, 9});
+  if (!encoded) throw InputError(InputMessage(path, "", "cannot encode PNG"));
   WriteFileAtomically(path, [&](std::ostream& out) { out.write(reinterpret_cast<const char*>(bytes.data()), bytes.size()); });
 }
 

@@ -26,13 +26,10 @@ void WriteProjectionDiffFigure(const std::string& path, const ProjectionDiff& di
   for (size_t k = 0; k < diff.pixels.size(); ++k) {
     const Eigen::Vector2d& d = diff.difference_px[k];
     if (!d.allFinite()) continue;
-    cv::Mat level(1, 1, CV_8U, cv::Scalar(static_cast<int>(std::lround(255.0 * std::min(1.0, d.norm() / top)))));
-    cv::Mat colour;
-    cv::applyColorMap(level, colour, cv::COLORMAP_VIRIDIS);
-    const cv::Vec3b c = colour.at<cv::Vec3b>(0, 0);
+    const cv::Scalar colour = ColourMapColour(cv::COLORMAP_VIRIDIS, std::min(1.0, d.norm() / top));
     const cv::Point2d centre(diff.pixels[k].x(), diff.pixels[k].y());
     cv::rectangle(picture, cv::Rect2d(centre - cv::Point2d(0.5 * step_px, 0.5 * step_px), cv::Size2d(step_px, step_px)),
-                  cv::Scalar(c[0], c[1], c[2]), cv::FILLED);
+                  colour, cv::FILLED);
   }
   // Arrows on a coarser grid (every third cell) so they stay readable.
   const double arrow_step = 3.0 * step_px;
