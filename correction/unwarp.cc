@@ -5,7 +5,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <condition_variable>
+#include <deque>
+#include <exception>
 #include <filesystem>
+#include <mutex>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -60,17 +65,111 @@ cv::Mat Unwarper::Apply(const cv::Mat& frame, const std::string& source) const {
   return out;
 }
 
+namespace {
+
+// A bounded hand-over between two pipeline stages. Close() ends it: Pop then drains what is
+// left and returns false; Push returns false (the consumer has gone).
+class FrameQueue {
+ public:
+  explicit FrameQueue(size_t capacity) : capacity_(capacity) {}
+  bool Push(cv::Mat frame) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [&] { return closed_ || frames_.size() < capacity_; });
+    if (closed_) return false;
+    frames_.push_back(std::move(frame));
+    changed_.notify_all();
+    return true;
+  }
+  bool Pop(cv::Mat* frame) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [&] { return closed_ || !frames_.empty(); });
+    if (frames_.empty()) return false;
+    *frame = std::move(frames_.front());
+    frames_.pop_front();
+    changed_.notify_all();
+    return true;
+  }
+  void Close() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    closed_ = true;
+    changed_.notify_all();
+  }
+
+ private:
+  const size_t capacity_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<cv::Mat> frames_;
+  bool closed_ = false;
+};
+
+// The first exception a stage threw, kept for the calling thread to rethrow.
+class FirstError {
+ public:
+  void Keep(std::exception_ptr error) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!error_) error_ = std::move(error);
+  }
+  std::exception_ptr Get() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return error_;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::exception_ptr error_;
+};
+
+}  // namespace
+
 long UnwarpFrames(const Unwarper& unwarper, const std::function<bool(cv::Mat*)>& read,
                   const std::function<void(const cv::Mat&)>& write, long total_frames, const std::string& source,
                   const ProgressCallback& progress) {
   ProgressReporter reporter(progress, "unwarp", total_frames);
+  // Three stages overlap: decoding on one thread, the remap here, encoding on another, a
+  // couple of frames queued between them (video decode and encode are mostly one-threaded;
+  // the remap is a few ms). Each frame is read into a fresh Mat: a queued frame must not
+  // share its buffer with the next read. Frames are written in order; when a stage fails
+  // or the callback says stop, the frames already unwarped are still written, the other
+  // stages end, and the first error is rethrown here.
+  constexpr size_t kQueuedFrames = 3;
+  FrameQueue decoded(kQueuedFrames), unwarped(kQueuedFrames);
+  FirstError error;
+  std::thread reader([&] {
+    try {
+      for (;;) {
+        cv::Mat frame;
+        if (!read(&frame) || !decoded.Push(std::move(frame))) break;
+      }
+    } catch (...) {
+      error.Keep(std::current_exception());
+    }
+    decoded.Close();
+  });
+  std::thread writer([&] {
+    try {
+      for (cv::Mat frame; unwarped.Pop(&frame);) write(frame);
+    } catch (...) {
+      error.Keep(std::current_exception());
+      decoded.Close();  // stops the reader; the remap loop then ends
+    }
+    unwarped.Close();
+  });
   long frames = 0;
-  cv::Mat frame;
-  while (read(&frame)) {
-    write(unwarper.Apply(frame, source));
-    ++frames;
-    reporter.Step();
+  try {
+    for (cv::Mat frame; decoded.Pop(&frame);) {
+      if (!unwarped.Push(unwarper.Apply(frame, source))) break;  // the writer failed
+      ++frames;
+      reporter.Step();
+    }
+  } catch (...) {
+    error.Keep(std::current_exception());
   }
+  decoded.Close();
+  unwarped.Close();
+  reader.join();
+  writer.join();
+  if (std::exception_ptr thrown = error.Get()) std::rethrow_exception(thrown);
   if (frames == 0) throw InputError(InputMessage(source, "", "has no readable frames"));
   return frames;
 }

@@ -201,6 +201,87 @@ TEST(Cancellation, EveryJobThrowsCancelled) {
   EXPECT_EQ(written, 3);
 }
 
+// UnwarpFrames overlaps reading, remapping and writing on three threads: the frames must
+// still come out in order, each exactly what Apply gives it alone.
+TEST(UnwarpFrames, WritesEveryFrameInOrderAsApplyWould) {
+  const Sensor sensor = Shipped("ohte-sph");
+  RemapOptions remap;
+  remap.view = SmallPanoramaAtN7();
+  const Unwarper unwarper(BuildRemap(sensor, remap).table, sensor.image_width_px(), sensor.image_height_px(),
+                          Interpolation::kLinear);
+  std::vector<cv::Mat> inputs;
+  for (int k = 0; k < 25; ++k) {
+    cv::Mat frame(1000, 1000, CV_8UC3);
+    cv::randu(frame, cv::Scalar::all(0), cv::Scalar::all(10 * k + 6));
+    inputs.push_back(frame);
+  }
+  size_t next = 0;
+  std::vector<cv::Mat> written;
+  const long frames = UnwarpFrames(
+      unwarper,
+      [&](cv::Mat* f) {
+        if (next == inputs.size()) return false;
+        *f = inputs[next++].clone();
+        return true;
+      },
+      [&](const cv::Mat& f) { written.push_back(f); }, 0, "clip");
+  EXPECT_EQ(frames, 25);
+  ASSERT_EQ(written.size(), inputs.size());
+  for (size_t k = 0; k < inputs.size(); ++k)
+    EXPECT_EQ(cv::norm(written[k], unwarper.Apply(inputs[k], "clip"), cv::NORM_INF), 0.0) << "frame " << k;
+}
+
+// A stage that fails ends the others: no hang, the first error reaches the caller, and the
+// frames unwarped before a bad frame are still written.
+TEST(UnwarpFrames, ReaderWriterAndBadFrameErrorsReachTheCaller) {
+  const Sensor sensor = Shipped("ohte-sph");
+  RemapOptions remap;
+  remap.view = SmallPanoramaAtN7();
+  const Unwarper unwarper(BuildRemap(sensor, remap).table, sensor.image_width_px(), sensor.image_height_px(),
+                          Interpolation::kLinear);
+  const cv::Mat good(1000, 1000, CV_8UC1, cv::Scalar(90)), small(10, 20, CV_8UC1);
+  int reads = 0, writes = 0;
+  auto endless = [&](cv::Mat* f) { return (*f = good, ++reads, true); };
+  EXPECT_EQ(InputErrorOf([&] {
+              UnwarpFrames(
+                  unwarper, endless,
+                  [&](const cv::Mat&) {
+                    if (++writes == 4) throw InputError("out.avi: disk full");
+                  },
+                  0, "clip");
+            }),
+            "out.avi: disk full");
+  EXPECT_EQ(writes, 4);
+
+  reads = writes = 0;
+  EXPECT_EQ(InputErrorOf([&] {
+              UnwarpFrames(
+                  unwarper,
+                  [&](cv::Mat* f) {
+                    if (++reads == 6) throw InputError("clip: corrupt packet");
+                    *f = good;
+                    return true;
+                  },
+                  [&](const cv::Mat&) { ++writes; }, 0, "clip");
+            }),
+            "clip: corrupt packet");
+  EXPECT_EQ(writes, 5);
+
+  reads = writes = 0;
+  EXPECT_EQ(InputErrorOf([&] {
+              UnwarpFrames(
+                  unwarper, [&](cv::Mat* f) { return (*f = ++reads == 3 ? small : good, true); },
+                  [&](const cv::Mat&) { ++writes; }, 0, "clip");
+            }),
+            "clip: is 20 x 10 px but the sensor's image is 1000 x 1000 px");
+  EXPECT_EQ(writes, 2);
+
+  EXPECT_EQ(InputErrorOf([&] {
+              UnwarpFrames(unwarper, [](cv::Mat*) { return false; }, [](const cv::Mat&) {}, 0, "empty.avi");
+            }),
+            "empty.avi: has no readable frames");
+}
+
 TEST(ViewRequest, ErrorsNameTheField) {
   const Sensor sensor = Shipped("ohte-sph");
   auto error_of = [&](const std::function<void(ViewRequest*)>& change) {

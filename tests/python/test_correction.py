@@ -304,6 +304,21 @@ def test_unwarp_equals_cli_and_cv2_remap(cli, data, tmp_path):
     assert all(np.array_equal(w, omnical.unwarp(f, maps)) for w, f in zip(written, frames))
     with pytest.raises(omnical.InputError, match="^camera: has no readable frames$"):
         unwarper.apply_frames([], written.append, source="camera")
+    # Frames are read ahead on another thread: a reader that refills one buffer (as video
+    # readers may) must still get each frame unwarped as it was when yielded.
+    def refilled():
+        buffer = np.empty_like(image)
+        for frame in frames * 4:
+            buffer[...] = frame
+            yield buffer
+    written = []
+    assert unwarper.apply_frames(refilled(), written.append) == 12
+    assert all(np.array_equal(w, omnical.unwarp(f, maps)) for w, f in zip(written, frames * 4))
+    # An exception in write (called on the writer thread) reaches the caller as itself.
+    def full(_):
+        raise OSError("disk full")
+    with pytest.raises(OSError, match="^disk full$"):
+        unwarper.apply_frames(iter(frames * 10), full)
 
 
 def mei_project(parameters, central_from_mirror, v0_mm, points_in_mirror):

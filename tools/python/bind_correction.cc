@@ -224,19 +224,20 @@ Unwarper UnwarperOf(const py::object& maps, const py::object& image, Interpolati
 
 // Frames from an iterable through UnwarpFrames (its checks, progress stage "unwarp"),
 // each unwarped frame handed to write(frame); the GIL is held only to read and write.
+// UnwarpFrames reads on one thread and writes on another, a few frames ahead of the
+// remap: each frame is copied out of its array, which the iterator may reuse or free.
 long ApplyFrames(const Unwarper& unwarper, const py::object& frames, const py::object& write, long total,
                  const std::string& source, const py::object& progress) {
   const py::iterator iterator = py::iter(frames);
-  py::object current;  // the frame being unwarped (its Mat may refer to its memory)
   const ProgressCallback callback = ForwardProgress(progress);
   auto read = [&](cv::Mat* frame) {
     py::gil_scoped_acquire gil;
-    current = py::reinterpret_steal<py::object>(PyIter_Next(iterator.ptr()));
+    const auto current = py::reinterpret_steal<py::object>(PyIter_Next(iterator.ptr()));
     if (!current) {
       if (PyErr_Occurred()) throw py::error_already_set();
       return false;
     }
-    *frame = MatOf(current, source.c_str());
+    *frame = MatOf(current, source.c_str()).clone();
     return true;
   };
   auto emit = [&](const cv::Mat& unwarped) {
