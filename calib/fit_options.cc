@@ -91,7 +91,7 @@ ceres::Solver::Options DefaultSolverOptions() {
   // tests/python/test_calib.py).
   solver.linear_solver_type = ceres::DENSE_SCHUR;
   solver.max_num_iterations = 200;
-  solver.function_tolerance = 1e-16;
+  solver.function_tolerance = 1e-12;
   solver.gradient_tolerance = 1e-16;
   solver.parameter_tolerance = 1e-15;
   solver.num_threads = 1;
