@@ -40,6 +40,14 @@ ViewRequest SmallPanoramaAtN7() {
   return view;
 }
 
+// The shipped sphere's small panorama at n = 7, as an unwarper of its 1000 x 1000 images.
+Unwarper SmallPanoramaUnwarper(Interpolation interpolation) {
+  const Sensor sensor = Shipped("ohte-sph");
+  RemapOptions remap;
+  remap.view = SmallPanoramaAtN7();
+  return Unwarper(BuildRemap(sensor, remap).table, sensor.image_width_px(), sensor.image_height_px(), interpolation);
+}
+
 // The InputError message of `job`, "" if it throws none.
 template <typename Job>
 std::string InputErrorOf(Job&& job) {
@@ -204,11 +212,7 @@ TEST(Cancellation, EveryJobThrowsCancelled) {
 // UnwarpFrames overlaps reading, remapping and writing on three threads: the frames must
 // still come out in order, each exactly what Apply gives it alone.
 TEST(UnwarpFrames, WritesEveryFrameInOrderAsApplyWould) {
-  const Sensor sensor = Shipped("ohte-sph");
-  RemapOptions remap;
-  remap.view = SmallPanoramaAtN7();
-  const Unwarper unwarper(BuildRemap(sensor, remap).table, sensor.image_width_px(), sensor.image_height_px(),
-                          Interpolation::kLinear);
+  const Unwarper unwarper = SmallPanoramaUnwarper(Interpolation::kLinear);
   std::vector<cv::Mat> inputs;
   for (int k = 0; k < 25; ++k) {
     cv::Mat frame(1000, 1000, CV_8UC3);
@@ -234,11 +238,7 @@ TEST(UnwarpFrames, WritesEveryFrameInOrderAsApplyWould) {
 // A stage that fails ends the others: no hang, the first error reaches the caller, and the
 // frames unwarped before a bad frame are still written.
 TEST(UnwarpFrames, ReaderWriterAndBadFrameErrorsReachTheCaller) {
-  const Sensor sensor = Shipped("ohte-sph");
-  RemapOptions remap;
-  remap.view = SmallPanoramaAtN7();
-  const Unwarper unwarper(BuildRemap(sensor, remap).table, sensor.image_width_px(), sensor.image_height_px(),
-                          Interpolation::kLinear);
+  const Unwarper unwarper = SmallPanoramaUnwarper(Interpolation::kLinear);
   const cv::Mat good(1000, 1000, CV_8UC1, cv::Scalar(90)), small(10, 20, CV_8UC1);
   int reads = 0, writes = 0;
   auto endless = [&](cv::Mat* f) { return (*f = good, ++reads, true); };
@@ -315,11 +315,7 @@ TEST(ViewRequest, ErrorsNameTheField) {
 }
 
 TEST(Unwarper, RefusesFramesOfAnotherSizeNamingTheSource) {
-  const Sensor sensor = Shipped("ohte-sph");
-  RemapOptions remap;
-  remap.view = SmallPanoramaAtN7();
-  const Unwarper unwarper(BuildRemap(sensor, remap).table, sensor.image_width_px(), sensor.image_height_px(),
-                          Interpolation::kNearest);
+  const Unwarper unwarper = SmallPanoramaUnwarper(Interpolation::kNearest);
   EXPECT_EQ(InputErrorOf([&] { unwarper.Apply(cv::Mat(10, 20, CV_8UC1), "frame.png"); }),
             "frame.png: is 20 x 10 px but the sensor's image is 1000 x 1000 px");
   const cv::Mat out = unwarper.Apply(cv::Mat(1000, 1000, CV_8UC1, cv::Scalar(77)), "frame.png");
