@@ -51,7 +51,10 @@ class Unwarper {
 // Frames from `read` (false at the end) through the unwarper to `write`, reporting stage
 // "unwarp" against `total_frames` (0: unknown); returns the number of frames. InputError
 // naming `source` if it has none or a frame of the wrong size; Cancelled when the callback
-// says stop.
+// says stop. Decoding, remapping and encoding overlap: `read` is called on one thread and
+// `write` on another (each always from the same one, in frame order), a few frames apart;
+// each read must fill a Mat that does not share the previous frame's buffer. An exception
+// from either reaches the caller, after the frames already unwarped are written.
 long UnwarpFrames(const Unwarper& unwarper, const std::function<bool(cv::Mat*)>& read,
                   const std::function<void(const cv::Mat&)>& write, long total_frames, const std::string& source,
                   const ProgressCallback& progress = nullptr);
