@@ -53,7 +53,8 @@ class Unwarper {
 // naming `source` if it has none or a frame of the wrong size; Cancelled when the callback
 // says stop. Decoding, remapping and encoding overlap: `read` is called on one thread and
 // `write` on another (each always from the same one, in frame order), a few frames apart;
-// each read must fill a Mat that does not share the previous frame's buffer. An exception
+// `read` gets an empty Mat each time, and a frame's pixels must not change once it
+// returns them (a reader refilling one buffer must copy). An exception
 // from either reaches the caller, after the frames already unwarped are written.
 long UnwarpFrames(const Unwarper& unwarper, const std::function<bool(cv::Mat*)>& read,
                   const std::function<void(const cv::Mat&)>& write, long total_frames, const std::string& source,
