@@ -146,15 +146,22 @@ long UnwarpFrames(const Unwarper& unwarper, const std::function<bool(cv::Mat*)>&
     }
     decoded.Close();
   });
-  std::thread writer([&] {
-    try {
-      for (cv::Mat frame; unwarped.Pop(&frame);) write(frame);
-    } catch (...) {
-      error.Keep(std::current_exception());
-      decoded.Close();  // stops the reader; the remap loop then ends
-    }
-    unwarped.Close();
-  });
+  std::thread writer;
+  try {
+    writer = std::thread([&] {
+      try {
+        for (cv::Mat frame; unwarped.Pop(&frame);) write(frame);
+      } catch (...) {
+        error.Keep(std::current_exception());
+        decoded.Close();  // stops the reader; the remap loop then ends
+      }
+      unwarped.Close();
+    });
+  } catch (...) {  // no thread to write on (std::system_error): a joinable reader must not be destroyed
+    decoded.Close();
+    reader.join();
+    throw;
+  }
   long frames = 0;
   try {
     for (cv::Mat frame; decoded.Pop(&frame);) {

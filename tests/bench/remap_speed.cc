@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -151,7 +152,8 @@ int Main(bool check) {
   // A clip through the unwarper, MJPG in and out (what `omnical unwarp` writes to .avi):
   // frame by frame, decode then remap then encode, against UnwarpFrames, which overlaps
   // the three (correction/unwarp.h). The same frames, maps and codec settings.
-  const std::filesystem::path clip_dir = std::filesystem::temp_directory_path() / "omnical-remap-speed";
+  const std::filesystem::path clip_dir =
+      std::filesystem::temp_directory_path() / ("omnical-remap-speed-" + std::to_string(::getpid()));
   std::filesystem::create_directories(clip_dir);
   const std::string clip = (clip_dir / "in.avi").string(), unwarped_clip = (clip_dir / "out.avi").string();
   const int clip_frames = 120;

@@ -226,11 +226,14 @@ Unwarper UnwarperOf(const py::object& maps, const py::object& image, Interpolati
 // each unwarped frame handed to write(frame); the GIL is held only to read and write.
 // UnwarpFrames reads on one thread and writes on another, a few frames ahead of the
 // remap: each frame is copied out of its array, which the iterator may reuse or free.
+// Neither thread takes the GIL once the interpreter is shutting down (a daemon thread's
+// call): taking it then would end the thread inside the library.
 long ApplyFrames(const Unwarper& unwarper, const py::object& frames, const py::object& write, long total,
                  const std::string& source, const py::object& progress) {
   const py::iterator iterator = py::iter(frames);
   const ProgressCallback callback = ForwardProgress(progress);
   auto read = [&](cv::Mat* frame) {
+    if (Finalizing()) throw Cancelled("unwarp");
     py::gil_scoped_acquire gil;
     const auto current = py::reinterpret_steal<py::object>(PyIter_Next(iterator.ptr()));
     if (!current) {
@@ -241,6 +244,7 @@ long ApplyFrames(const Unwarper& unwarper, const py::object& frames, const py::o
     return true;
   };
   auto emit = [&](const cv::Mat& unwarped) {
+    if (Finalizing()) throw Cancelled("unwarp");
     py::gil_scoped_acquire gil;
     write(ArrayOf(unwarped));
   };
@@ -419,7 +423,12 @@ Returns a RemapResult; InputError names the keyword ("size: '12' is not WxH ..."
            "progress"_a = py::none(),
            R"(Every frame of an iterable (e.g. read from cv2.VideoCapture) unwarped and passed to
 write(frame); returns the number of frames. InputError naming `source` when there are no
-frames or one has the wrong size. progress stage "unwarp" against `total` (0: unknown).)")
+frames or one has the wrong size. progress stage "unwarp" against `total` (0: unknown).
+Reading, unwarping and writing overlap: the iterable is advanced on one worker thread
+and write is called on another (each frame copied when read, written in order), so an
+iterator bound to the calling thread (e.g. a sqlite3 cursor) cannot be used, Ctrl-C
+waits for a blocked iterator to yield, and on an error up to a few frames already read
+are dropped.)")
       .def_property_readonly(
           "size", [](const Unwarper& u) { return py::make_tuple(u.width_px(), u.height_px()); },
           "(width, height) of the output, px.");

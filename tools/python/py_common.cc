@@ -23,14 +23,6 @@ void OnSigint(int signal) {
     g_python_sigint.sa_handler(signal);
 }
 
-bool Finalizing() {
-#if PY_VERSION_HEX >= 0x030D0000
-  return Py_IsFinalizing();
-#else
-  return _Py_IsFinalizing();
-#endif
-}
-
 bool OnMainThread() {
   const py::object threading = py::module_::import("threading");
   return threading.attr("current_thread")().is(threading.attr("main_thread")());
@@ -80,6 +72,14 @@ class SigintWatch {
 };
 
 }  // namespace
+
+bool Finalizing() {
+#if PY_VERSION_HEX >= 0x030D0000
+  return Py_IsFinalizing();
+#else
+  return _Py_IsFinalizing();
+#endif
+}
 
 GilReleased::~GilReleased() {
   if (Finalizing())

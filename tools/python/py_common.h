@@ -76,6 +76,10 @@ std::string PathOf(const py::handle& path);
 // the call. It also returns false once SIGINT arrived during the call (RunReleased).
 ProgressCallback ForwardProgress(py::object progress);
 
+// True once the interpreter is shutting down: a worker thread must not take the GIL then
+// (it would be ended inside the library's code).
+bool Finalizing();
+
 // Runs job() with the GIL released and Ctrl-C watched (on the main thread: a SIGINT
 // handler chained to Python's sets a flag the progress callback returns), turning the
 // library's Cancelled into KeyboardInterrupt when Ctrl-C caused it, else
