@@ -11,9 +11,10 @@
 // both axes and three of its four sides show the board's white margin somewhere (a point
 // one step beyond, no X-junction, with paper further out; the fourth may lie beyond the
 // rim): then each corner's row and column on the board follow (up to the 180 deg turn
-// calib/detect.h resolves from the print). A part that spans less could sit anywhere along the short axis (returned, not
-// placed: aim a view at it); one larger than the board, or cut to its size by the rim or
-// the image's edge with paper seen on fewer sides, is a patch of a larger pattern (tiles).
+// calib/detect.h resolves from the print). A part that spans less could sit anywhere
+// along the short axis (returned, not placed: aim a view at it); one larger than the
+// board, or cut to its size by the rim or the image's edge with paper seen on fewer
+// sides, is a patch of a larger pattern (tiles).
 #pragma once
 
 #include <Eigen/Core>

@@ -16,6 +16,7 @@
 
 #include "correction/maps_json.h"
 #include "model/io/atomic_write.h"
+#include "model/first_error.h"
 #include "model/input_error.h"
 
 namespace omnical {
@@ -103,23 +104,6 @@ class FrameQueue {
   bool closed_ = false;
 };
 
-// The first exception a stage threw, kept for the calling thread to rethrow.
-class FirstError {
- public:
-  void Keep(std::exception_ptr error) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!error_) error_ = std::move(error);
-  }
-  std::exception_ptr Get() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return error_;
-  }
-
- private:
-  std::mutex mutex_;
-  std::exception_ptr error_;
-};
-
 }  // namespace
 
 long UnwarpFrames(const Unwarper& unwarper, const std::function<bool(cv::Mat*)>& read,
@@ -176,7 +160,7 @@ long UnwarpFrames(const Unwarper& unwarper, const std::function<bool(cv::Mat*)>&
   unwarped.Close();
   reader.join();
   writer.join();
-  if (std::exception_ptr thrown = error.Get()) std::rethrow_exception(thrown);
+  error.RethrowIfAny();
   if (frames == 0) throw InputError(InputMessage(source, "", "has no readable frames"));
   return frames;
 }

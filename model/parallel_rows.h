@@ -5,11 +5,10 @@
 
 #include <algorithm>
 #include <atomic>
-#include <exception>
-#include <mutex>
 #include <thread>
 #include <vector>
 
+#include "model/first_error.h"
 #include "model/worker_threads.h"
 
 namespace omnical {
@@ -20,15 +19,13 @@ namespace omnical {
 template <typename RowFunction>
 void ParallelRows(int rows, int threads, const RowFunction& row) {
   std::atomic<int> next{0};
-  std::exception_ptr thrown;
-  std::mutex thrown_mutex;
+  FirstError thrown;
   auto work = [&]() {
     for (int v = next++; v < rows; v = next++) {
       try {
         row(v);
       } catch (...) {
-        std::lock_guard<std::mutex> lock(thrown_mutex);
-        if (!thrown) thrown = std::current_exception();
+        thrown.Keep(std::current_exception());
         next = rows;
       }
     }
@@ -37,7 +34,7 @@ void ParallelRows(int rows, int threads, const RowFunction& row) {
   StartWorkers(std::min(threads, rows), work, &pool);
   work();
   for (std::thread& thread : pool) thread.join();
-  if (thrown) std::rethrow_exception(thrown);
+  thrown.RethrowIfAny();
 }
 
 }  // namespace omnical
