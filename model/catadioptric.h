@@ -64,7 +64,8 @@ struct Catadioptric {
   bool IsAxial() const { return pose.IsUntilted() && (kOrthographic || pose.IsCentred()); }
 
   bool InImage(double u, double v) const {
-    return u >= -0.5 && u <= image_width_px - 0.5 && v >= -0.5 && v <= image_height_px - 0.5;
+    // '&': no branches, for the batch loops.
+    return (u >= -0.5) & (u <= image_width_px - 0.5) & (v >= -0.5) & (v <= image_height_px - 0.5);
   }
 
   template <typename U>

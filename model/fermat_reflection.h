@@ -73,7 +73,7 @@ inline bool FermatNewtonStep(const FermatReflection& e, double* step_x, double* 
   const double det = e.j_xx * e.j_yy - e.j_xy * e.j_xy;
   *step_x = -(e.j_yy * e.f_x - e.j_xy * e.f_y) / det;
   *step_y = -(-e.j_xy * e.f_x + e.j_xx * e.f_y) / det;
-  return e.j_xx < 0.0 && det > 0.0;
+  return (e.j_xx < 0.0) & (det > 0.0);
 }
 
 // F alone in any scalar type: the Jet pass of the implicit-function step. Same

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "model/axial_reflection.h"
+#include "model/simd_clones.h"
 
 namespace omnical {
 
@@ -63,9 +64,23 @@ class AxialGuessTable {
 
   // Guessed reflection radius for a point at radius rho and height h (mirror frame).
   double Guess(double rho, double h) const {
-    double position = Position(rho, h, z_ref_mm_);
-    position = Position(rho, h, Lerp(viewpoint_of_w_, position));
-    return Lerp(x_of_w_, position);
+    double position = Position(rho, h, z_ref_mm_, w_max_, inv_dw_);
+    position = Position(rho, h, Lerp(viewpoint_of_w_.data(), position), w_max_, inv_dw_);
+    return Lerp(x_of_w_.data(), position);
+  }
+
+  // Guess for many points, the same arithmetic as Guess. The table positions (a sqrt
+  // and a division each) are computed in loops the compiler vectorises; the table
+  // reads stay scalar (GCC does not vectorise them into gathers for generic x86-64).
+  OMNICAL_CLONE_FOR_AVX2 void GuessMany(const double* rho, const double* h, int count, double* x_out) const {
+    // Locals, which the stores to x_out cannot alias.
+    const double* x_table = x_of_w_.data();
+    const double* viewpoint_table = viewpoint_of_w_.data();
+    const double z_ref_mm = z_ref_mm_, w_max = w_max_, inv_dw = inv_dw_;
+    for (int i = 0; i < count; ++i) x_out[i] = Position(rho[i], h[i], z_ref_mm, w_max, inv_dw);
+    for (int i = 0; i < count; ++i) x_out[i] = Lerp(viewpoint_table, x_out[i]);
+    for (int i = 0; i < count; ++i) x_out[i] = Position(rho[i], h[i], x_out[i], w_max, inv_dw);
+    for (int i = 0; i < count; ++i) x_out[i] = Lerp(x_table, x_out[i]);
   }
 
  private:
@@ -77,15 +92,18 @@ class AxialGuessTable {
   std::vector<double> viewpoint_of_w_;
 
   // Table position (fractional index) of the direction of (rho, h) seen from (0, z_v).
-  double Position(double rho, double h, double viewpoint_z) const {
+  static double Position(double rho, double h, double viewpoint_z, double w_max, double inv_dw) {
     const double dz = viewpoint_z - h;
     const double dist = std::sqrt(rho * rho + dz * dz);
     const double denom = dist + dz;
-    // Points almost straight above the viewpoint (Omega -> 180 deg) map to the rim.
-    const double w = denom > 1e-12 * dist ? rho / denom : w_max_;
-    return std::min(w, w_max_) * inv_dw_;
+    // Points almost straight above the viewpoint (Omega -> 180 deg) map to the rim, and
+    // so does anything not finite (the index must stay in the table). The division is
+    // done either way: one under a condition would keep GuessMany's loop scalar.
+    const double w = rho / denom;
+    const bool usable = (denom > 1e-12 * dist) & (w >= 0.0) & (w <= w_max);
+    return (usable ? w : w_max) * inv_dw;
   }
-  static double Lerp(const std::vector<double>& table, double position) {
+  static double Lerp(const double* table, double position) {
     const int i = static_cast<int>(position);
     const double t = position - i;
     return table[i] + t * (table[i + 1] - table[i]);

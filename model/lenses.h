@@ -34,15 +34,16 @@ struct PinholeLens {
   static constexpr bool kIsOrthographic = false;
   T fx_px, fy_px, cx_px, cy_px, k1, k2;
 
+  // Valid in front of the lens (Z > 0). The pixel is written either way (without a
+  // branch, so the batch loops vectorise); callers ignore it when false is returned.
   bool ProjectToPixel(const Vec3<T>& point_in_camera, Vec2<T>* pixel) const {
-    if (!(ScalarPart(point_in_camera.z()) > 0.0)) return false;
     const T x = point_in_camera.x() / point_in_camera.z();
     const T y = point_in_camera.y() / point_in_camera.z();
     const T r2 = x * x + y * y;
     const T radial = T(1.0) + r2 * (k1 + r2 * k2);
     (*pixel)(0) = fx_px * x * radial + cx_px;
     (*pixel)(1) = fy_px * y * radial + cy_px;
-    return true;
+    return ScalarPart(point_in_camera.z()) > 0.0;
   }
 
   // Undistorted radius r for a distorted radius rd: safeguarded Newton on
@@ -125,12 +126,12 @@ struct OrthographicLens {
   static constexpr bool kIsOrthographic = true;
   T scale_px_per_mm, cx_px, cy_px;
 
-  // Valid in front of the lens plane (Z > 0), where its rays come from.
+  // Valid in front of the lens plane (Z > 0), where its rays come from. The pixel is
+  // written either way, as the pinhole's is.
   bool ProjectToPixel(const Vec3<T>& point_in_camera, Vec2<T>* pixel) const {
-    if (!(ScalarPart(point_in_camera.z()) > 0.0)) return false;
     (*pixel)(0) = scale_px_per_mm * point_in_camera.x() + cx_px;
     (*pixel)(1) = scale_px_per_mm * point_in_camera.y() + cy_px;
-    return true;
+    return ScalarPart(point_in_camera.z()) > 0.0;
   }
   void PixelToRay(const Vec2<T>& pixel, Vec3<T>* origin, Vec3<T>* direction) const {
     *origin = Vec3<T>((pixel(0) - cx_px) / scale_px_per_mm, (pixel(1) - cy_px) / scale_px_per_mm, T(0.0));
