@@ -112,7 +112,8 @@ bool CheckerboardTurnedAround(const CalibrationTarget& target, const cv::Mat& gr
     // weighted by its contrast: one alone may sit where the rim bends the grid.
     double vote = 0.0;
     int voters = 0;
-    for (const auto& [index, origin] : at) {
+    for (const auto& [index, corner_px] : at) {
+      const Eigen::Vector2d origin = corner_px;  // a lambda may not capture a structured binding (C++17; clang refuses)
       const auto next_col = at.find({index.first, index.second + 1}), next_row = at.find({index.first + 1, index.second});
       if (next_col == at.end() || next_row == at.end()) continue;
       const Eigen::Vector2d along_x = next_col->second - origin, along_y = next_row->second - origin;

@@ -1,13 +1,26 @@
 #!/usr/bin/env bash
-# Fuzzes every parser of a user file with libFuzzer (issue 8): builds tests/fuzz with clang
-# under ASan + UBSan (build/fuzz, OMNICAL_FUZZ=ON), makes a seed corpus from
-# datasets-synthetic (and small outputs of omnical itself: detections, maps, a designed
-# profile), runs each target for SECONDS (default 60) and writes docs/fuzzing.md with the
-# executions each survived. A crash stops the script with the reproducer under
-# build/fuzz/crashes/ (rerun: OMNICAL_FUZZ_TARGET=<target> build/fuzz/tests/fuzz/omnical_fuzz FILE).
-# Usage: scripts/fuzz.sh [SECONDS]
+# Fuzzes every parser of a user file with libFuzzer (issues 8, 21): builds tests/fuzz with
+# clang under ASan + UBSan (build/fuzz, OMNICAL_FUZZ=ON), makes a seed corpus from
+# datasets-synthetic, small outputs of omnical itself (detections, maps, a designed
+# profile) and the committed minimized corpora (tests/fuzz/corpus/<target>), runs each
+# target for SECONDS (default 60) or for N executions (--runs N), as many targets at once
+# as there are cores, and writes docs/fuzzing.md with the executions each survived.
+# --update-corpus then merges each target's corpus, minimized (libFuzzer -merge=1: the
+# fewest inputs that keep every feature reached), into tests/fuzz/corpus/<target>.
+# A crash stops the script with the reproducer under build/fuzz/crashes/
+# (rerun: OMNICAL_FUZZ_TARGET=<target> build/fuzz/tests/fuzz/omnical_fuzz FILE).
+# Usage: scripts/fuzz.sh [SECONDS | --runs N] [--update-corpus]
 set -euo pipefail
-seconds=${1:-60}
+seconds=60
+runs=""
+update_corpus=0
+while [ $# -gt 0 ]; do
+  case $1 in
+    --runs) runs=$2; shift 2 ;;
+    --update-corpus) update_corpus=1; shift ;;
+    *) seconds=$1; shift ;;
+  esac
+done
 omnical_build_kind=fuzz
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 omnical_packages+=(clang libclang-rt-14-dev)
@@ -48,33 +61,72 @@ d["images"][0]["corners"] = d["images"][0]["corners"][:6]
 json.dump(d, open(sys.argv[2], "w"), indent=1)
 PY
 
-mkdir -p "$build_dir/crashes" "$build_dir/corpus"
-rows=()
-for target in sensor_yaml scene_yaml target_yaml design_spec_yaml detections_json maps_json maps_yml points_csv profile_csv; do
-  corpus=$build_dir/corpus/$target
+committed=$omnical_root/tests/fuzz/corpus
+targets=(sensor_yaml scene_yaml target_yaml design_spec_yaml detections_json maps_json maps_yml points_csv profile_csv)
+for target in "${targets[@]}"; do
+  [ -d "$committed/$target" ] && cp "$committed/$target"/* "$seeds/$target/" 2>/dev/null || true
+done
+if [ -n "$runs" ]; then limit=(-runs="$runs"); limit_text="$runs executions"; else limit=(-max_total_time="$seconds"); limit_text="$seconds s"; fi
+
+rm -rf "$build_dir/corpus" "$build_dir/results"
+mkdir -p "$build_dir/crashes" "$build_dir/corpus" "$build_dir/results"
+# One target: fuzz, then write "runs seconds corpus_size" to results/<target> (nothing on a crash).
+fuzz_target() {
+  local target=$1 corpus=$build_dir/corpus/$1 log=$build_dir/$1.log start=$SECONDS
   mkdir -p "$corpus"
-  log=$build_dir/$target.log
-  echo "fuzzing $target for $seconds s"
-  if ! OMNICAL_FUZZ_TARGET=$target "$fuzzer" -max_total_time="$seconds" -max_len=16384 -rss_limit_mb=4096 -timeout=20 \
-      -artifact_prefix="$build_dir/crashes/$target-" "$corpus" "$seeds/$target" >"$log" 2>&1; then
-    echo "omnical: $target crashed; see $log and $build_dir/crashes/" >&2
-    tail -30 "$log" >&2
-    exit 1
+  if ! OMNICAL_FUZZ_TARGET=$target "$fuzzer" "${limit[@]}" -max_len=16384 -rss_limit_mb=4096 -timeout=20 \
+      -print_final_stats=1 -artifact_prefix="$build_dir/crashes/$target-" "$corpus" "$seeds/$target" >"$log" 2>&1; then
+    return 1
   fi
-  runs=$(sed -n 's/^Done \([0-9]*\) runs in \([0-9]*\) second.*/\1/p' "$log")
-  rows+=("| \`$target\` | $(ls "$seeds/$target" | wc -l) | $seconds | $runs | $(ls "$corpus" | wc -l) | no crash |")
+  local done_runs
+  done_runs=$(sed -n 's/^stat::number_of_executed_units: *\([0-9]*\).*/\1/p' "$log")
+  echo "$done_runs $((SECONDS - start)) $(ls "$corpus" | wc -l)" >"$build_dir/results/$target"
+}
+echo "fuzzing ${#targets[@]} targets for $limit_text each, $jobs at a time (logs: $build_dir/<target>.log)"
+for target in "${targets[@]}"; do
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n || true; done
+  fuzz_target "$target" &
+done
+wait
+failed=0
+for target in "${targets[@]}"; do
+  if [ ! -s "$build_dir/results/$target" ]; then
+    echo "omnical: $target crashed; see $build_dir/$target.log and $build_dir/crashes/" >&2
+    tail -30 "$build_dir/$target.log" >&2
+    failed=1
+  fi
+done
+[ "$failed" = 0 ] || exit 1
+
+rows=()
+for target in "${targets[@]}"; do
+  read -r done_runs took corpus_size <"$build_dir/results/$target"
+  rows+=("| \`$target\` | $(ls "$seeds/$target" | wc -l) | $done_runs | $took | $((done_runs / (took > 0 ? took : 1))) | $corpus_size | no crash |")
 done
 
+if [ "$update_corpus" = 1 ]; then
+  for target in "${targets[@]}"; do
+    merged=$build_dir/merged/$target
+    rm -rf "$merged" && mkdir -p "$merged"
+    OMNICAL_FUZZ_TARGET=$target "$fuzzer" -merge=1 -max_len=16384 -rss_limit_mb=4096 -timeout=20 \
+      "$merged" "$build_dir/corpus/$target" "$seeds/$target" >"$build_dir/$target.merge.log" 2>&1
+    rm -rf "${committed:?}/$target" && mkdir -p "$committed/$target"
+    cp "$merged"/* "$committed/$target/"
+    echo "$target: $(ls "$committed/$target" | wc -l) inputs, $(du -sk "$committed/$target" | cut -f1) KB in tests/fuzz/corpus/$target"
+  done
+fi
+
 {
-  echo "# Fuzzing the parsers (generated by scripts/fuzz.sh $seconds; do not edit)"
+  echo "# Fuzzing the parsers (generated by scripts/fuzz.sh ${runs:+--runs }${runs:-$seconds}; do not edit)"
   echo
   echo "libFuzzer (clang $(clang --version | sed -n 's/.*version \([0-9.]*\).*/\1/p;q')) with ASan + UBSan over omnical's"
   echo "parsers of user files (\`tests/fuzz/fuzz_parsers.cc\`); the input is written to a file and"
   echo "read as the CLI reads it; refusing it with \`InputError\` is the only accepted answer."
-  echo "Seeds: datasets-synthetic's files and small outputs of omnical itself. Run on $(date -u +%Y-%m-%d), $(nproc) cores."
+  echo "Seeds: datasets-synthetic's files, small outputs of omnical itself and the committed minimized"
+  echo "corpora (\`tests/fuzz/corpus/<target>\`). Run on $(date -u +%Y-%m-%d), $(nproc) cores, $jobs targets at a time."
   echo
-  echo "| target | seeds | seconds | executions survived | corpus after | result |"
-  echo "| --- | --- | --- | --- | --- | --- |"
+  echo "| target | seeds | executions survived | seconds | executions/s | corpus after | result |"
+  echo "| --- | --- | --- | --- | --- | --- | --- |"
   printf '%s\n' "${rows[@]}"
 } >"$omnical_root/docs/fuzzing.md.tmp"
 mv "$omnical_root/docs/fuzzing.md.tmp" "$omnical_root/docs/fuzzing.md"
