@@ -59,7 +59,13 @@ OMNICAL_CLONE_FOR_AVX2 void ProjectPointsBatch(const Model& model, const Project
     // 1. Mirror-frame coordinates (rotation^T (p - t); an axial sensor's rotation is the
     //    identity) and the table guess.
     for (int i = 0; i < n; ++i) {
-      const double x = block[3 * i] - t_x, y = block[3 * i + 1] - t_y, z = block[3 * i + 2] - t_z;
+      // A point with a NaN, infinite or huge coordinate fails the checks in step 4 and gets
+      // its status from the scalar solver; the vector loops work on a harmless stand-in
+      // instead, so that no profile sees a NaN (a spline's segment index would be one).
+      const bool finite = std::max(std::max(std::abs(block[3 * i]), std::abs(block[3 * i + 1])),
+                                   std::abs(block[3 * i + 2])) <= detail::kMaxCoordinateMm;
+      const double x = (finite ? block[3 * i] : 10.0 * rim) - t_x, y = (finite ? block[3 * i + 1] : 0.0) - t_y,
+                   z = (finite ? block[3 * i + 2] : 0.0) - t_z;
       px[i] = r00 * x + r10 * y + r20 * z;
       py[i] = r01 * x + r11 * y + r21 * z;
       pz[i] = r02 * x + r12 * y + r22 * z;
@@ -112,11 +118,12 @@ OMNICAL_CLONE_FOR_AVX2 void ProjectPointsBatch(const Model& model, const Project
               EvaluateFermatReflection<kOrtho>(lens_x, lens_y, lens_z, mirror, px[i], py[i], pz[i], qx[i], qy[i]);
           double step_x = 0.0, step_y = 0.0;
           const bool descends = FermatNewtonStep(e, &step_x, &step_y);
+          // The forward condition at the point the step starts from, where the slopes are.
+          ahead[i] = (px[i] - qx[i]) * e.slope_x + (py[i] - qy[i]) * e.slope_y - (pz[i] - e.z);
           qx[i] += step_x;
           qy[i] += step_y;
           // (A sqrt under a condition would keep the loop from vectorising.)
           last_step[i] = std::sqrt(step_x * step_x + step_y * step_y) + (descends ? 0.0 : HUGE_VAL);
-          ahead[i] = (px[i] - qx[i]) * e.slope_x + (py[i] - qy[i]) * e.slope_y - (pz[i] - e.z);
         }
       }
       // 3. The mirror point and its pixel.

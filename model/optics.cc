@@ -167,7 +167,9 @@ std::vector<AzimuthSample> ExactAzimuthCurve(const Sensor& sensor, double azimut
         auto pixel_of = [&](double x, Vec2<double>* pixel) {
           const Eigen::Vector3d in_mirror(x * std::cos(azimuth_rad), x * std::sin(azimuth_rad),
                                           model.mirror.EvaluateSag(x * x).z);
-          return model.lens.ProjectToPixel(rotation * in_mirror + translation, pixel);
+          const bool in_front = model.lens.ProjectToPixel(rotation * in_mirror + translation, pixel);
+          if (!in_front) pixel->setConstant(NAN);  // the lens writes the pixel either way
+          return in_front;
         };
         Vec2<double> vertex_pixel(NAN, NAN);
         pixel_of(0.0, &vertex_pixel);
@@ -198,8 +200,8 @@ std::string RimOutsideImage(const Sensor& sensor) {
           // A rim exactly on the image border (the seed's 2N = 1000 design) is inside: allow
           // the rounding of the projection.
           constexpr double kTolerancePx = 1e-6;
-          if (!model.lens.ProjectToPixel(rotation * rim_point + translation, &pixel) ||
-              !(pixel.x() >= -0.5 - kTolerancePx && pixel.x() <= model.image_width_px - 0.5 + kTolerancePx &&
+          if (!model.lens.ProjectToPixel(rotation * rim_point + translation, &pixel)) pixel.setConstant(NAN);
+          if (!(pixel.x() >= -0.5 - kTolerancePx && pixel.x() <= model.image_width_px - 0.5 + kTolerancePx &&
                 pixel.y() >= -0.5 - kTolerancePx && pixel.y() <= model.image_height_px - 0.5 + kTolerancePx)) {
             char text[160];
             std::snprintf(text, sizeof text, "the mirror rim images outside the %d x %d image (at azimuth %d deg: %.1f, %.1f px)",

@@ -82,7 +82,10 @@ struct SplineProfile {
       return {c1 * r2 + end.z + d * (end.dz_ds + S(0.5) * d * end.d2z_ds2), c1 + end.dz_ds + d * end.d2z_ds2,
               end.d2z_ds2};
     }
-    const int i = std::clamp(static_cast<int>(std::floor(ScalarPart(r2) / h)), 0, num_knots - 2);
+    // Clamped before the conversion: a NaN or huge r^2 (the batch solver's iterates for a
+    // point it will reject) must not reach static_cast<int>, which is undefined there.
+    const double segment = std::floor(ScalarPart(r2) / h);
+    const int i = segment > 0.0 ? static_cast<int>(std::min(segment, static_cast<double>(num_knots - 2))) : 0;
     const SagDerivatives<S> b = Segment<S>(i, (r2 - S(i * h)) / S(h), h);
     return {c1 * r2 + b.z, c1 + b.dz_ds, b.d2z_ds2};
   }
