@@ -7,6 +7,7 @@
 
 #include "calib/detections.h"
 #include "calib/synthetic/scene.h"
+#include "calib/target.h"
 #include "model/input_error.h"
 #include "model/sensor.h"
 #include "test_sensors.h"
@@ -180,7 +181,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadSensor{"tiny_focal", kTinyFocal.c_str(), "camera.fx: focal lengths below 1e-3 px"},
                       BadSensor{"huge_rim", kHugeRim.c_str(), "mirror.rim_radius: must be <= 100000"},
                       BadSensor{"mirror_behind_lens", kMirrorBehindLens.c_str(), "pose: part of the mirror lies behind the lens plane"},
-                      BadSensor{"non_string_key", kNonStringKey.c_str(), "unexpected YAML structure"},
+                      BadSensor{"non_string_key", kNonStringKey.c_str(), "has a key that is not a plain field name"},
                       BadSensor{"table_without_vertex", kTableWithoutVertex.c_str(), "the first row must be the vertex"},
                       BadSensor{"wavy_table", kWavyTable.c_str(), "mirror: the profile is not convex"},
                       BadSensor{"unknown_lens", kUnknownLens.c_str(), "camera.model: unknown lens model 'fisheye'"},
@@ -211,6 +212,24 @@ TEST(FuzzReproducers, ADirectoryWhereAFileBelongsIsRefused) {
   }
   EXPECT_THROW(LoadSensorYaml(crashes), InputError);
   EXPECT_THROW(ReadDetections(crashes), InputError);
+}
+
+// Regression (tests/fuzz, design_spec_yaml): the 3-byte file "? :" (a map whose key is a
+// null complex key) let yaml-cpp's bad-conversion exception out of every YAML reader's
+// unknown-field check.
+TEST(FuzzReproducers, AComplexKeyIsRefused) {
+  const std::string reproducer = testing::SourceDir() + "/tests/data/fuzz-crashes/design_spec_yaml-complex-key.yaml";
+  for (auto load : {+[](const std::string& path) { LoadSensorYaml(path); },
+                    +[](const std::string& path) { LoadSceneYaml(path); },
+                    +[](const std::string& path) { CalibrationTarget::FromYaml(path); }}) {
+    try {
+      load(reproducer);
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& error) {
+      // The readers check different fields first; each names the file.
+      EXPECT_NE(std::string(error.what()).find("complex-key.yaml"), std::string::npos) << error.what();
+    }
+  }
 }
 
 }  // namespace

@@ -32,6 +32,9 @@ void YamlFieldReader::RejectUnknown(const YAML::Node& map, const std::string& wh
                                     const std::set<std::string>& known) const {
   if (!map.IsMap()) Fail(where.empty() ? "(top level)" : where, "must be a map of fields");
   for (const auto& entry : map) {
+    // A complex key ("? [a, b]: ..." or "? :") is no field name; as<string> would throw
+    // yaml-cpp's own exception (found by the fuzzer).
+    if (!entry.first.IsScalar()) Fail(where.empty() ? "(top level)" : where, "has a key that is not a plain field name");
     const std::string key = entry.first.as<std::string>();
     if (!known.count(key)) {
       std::string list;
