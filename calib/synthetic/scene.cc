@@ -12,6 +12,15 @@
 namespace omnical {
 namespace {
 
+// A random seed: a whole number an unsigned 32-bit generator takes (a negative or huge
+// one cast to unsigned is undefined behaviour; found by the scene fuzzer with "seed: -1").
+unsigned SeedOr(const YamlFieldReader& reader, const YAML::Node& map, const std::string& where, unsigned fallback) {
+  const double seed = reader.NumberOr(map, "seed", where, fallback);
+  if (!(seed >= 0.0 && seed <= 4294967295.0) || seed != std::floor(seed))
+    reader.Fail(YamlFieldReader::Join(where, "seed"), "must be a whole number from 0 to 4294967295");
+  return static_cast<unsigned>(seed);
+}
+
 constexpr double kRad = M_PI / 180.0;
 
 using SceneReader = YamlFieldReader;
@@ -98,7 +107,7 @@ Scene LoadSceneYaml(const std::string& path) {
       f.noise_sigma = reader.NumberOr(render, "noise_sigma", "render", 0.0);
       f.blur_sigma_px = reader.NumberOr(render, "blur_sigma_px", "render", 0.0);
       f.vignetting = reader.NumberOr(render, "vignetting", "render", 0.0);
-      f.seed = static_cast<unsigned>(reader.NumberOr(render, "seed", "render", 1));
+      f.seed = SeedOr(reader, render, "render", 1);
       if (f.noise_sigma < 0.0 || f.noise_sigma > 100.0) reader.Fail("render.noise_sigma", "must be in [0, 100] grey levels");
       if (f.blur_sigma_px < 0.0 || f.blur_sigma_px > 50.0) reader.Fail("render.blur_sigma_px", "must be in [0, 50] px");
       if (f.vignetting < 0.0 || f.vignetting > 1.0) reader.Fail("render.vignetting", "must be in [0, 1]");
@@ -226,7 +235,7 @@ Scene LoadSceneYaml(const std::string& path) {
       const auto tilt = reader.Range(random, "tilt_deg", where, {0.0, 30.0});
       const auto roll = reader.Range(random, "roll_deg", where, {-30.0, 30.0});
       const std::string prefix = random["prefix"] ? random["prefix"].as<std::string>() : "random";
-      std::mt19937 rng(static_cast<unsigned>(reader.NumberOr(random, "seed", where, 1)));
+      std::mt19937 rng(SeedOr(reader, random, where, 1));
       auto uniform = [&](std::pair<double, double> r) { return std::uniform_real_distribution<double>(r.first, r.second)(rng); };
       for (int k = 0; k < static_cast<int>(count); ++k) {
         SceneView view;

@@ -217,8 +217,11 @@ if "$omnical" -q calibrate --target "$grid" --detections "$work/det.json" --sens
 else
   fail "calibrate exited $?"
 fi
-# Leave-one-image-out: one spread per parameter.
-"$omnical" -q calibrate --target "$grid" --detections "$work/det.json" --sensor "$guess" --out "$work/cal_loo" --leave-one-out 2>/dev/null &&
+# Leave-one-image-out: one spread per parameter. On 5 of the 8 views: 5 refits, not 8
+# (the library's tests check the spreads' values).
+python3 -c "import json,sys; d=json.load(open(sys.argv[1])); d['images']=d['images'][:5]; json.dump(d, open(sys.argv[2], 'w'))" \
+  "$work/det.json" "$work/det_five.json"
+"$omnical" -q calibrate --target "$grid" --detections "$work/det_five.json" --sensor "$guess" --out "$work/cal_loo" --leave-one-out 2>/dev/null &&
   python3 -c "import json,sys; d=json.load(open(sys.argv[1])); l=d['leave_one_out']; sys.exit(0 if set(l) == set(d['parameters']) and l['fx_px']['max'] >= l['fx_px']['min'] else 1)" "$work/cal_loo/calibration.json" &&
   pass || fail "calibrate --leave-one-out"
 # Generalisation: 2 views held out and evaluated, two halves compared; then omnical diff
