@@ -19,25 +19,50 @@
 # extension cannot load into Debian's uninstrumented interpreter (ASan must be the first
 # library loaded), so the sanitizer tree has OMNICAL_PYTHON=OFF. jet_derivatives_test
 # (56 s to compile there) is not built in it (tests/CMakeLists.txt).
+# The sanitizer tree is configured and built while the Release tests run, at the lowest
+# CPU priority (nice 19): it takes the CPU the tests leave idle (subprocesses starting,
+# files, single-threaded steps) and yields the rest, so the speed-ratio tests still get
+# their core.
 # Usage: scripts/test.sh [extra ctest arguments, for both passes]
 set -euo pipefail
 omnical_build_kind=test
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
-install_dependencies
-configure_and_build -DOMNICAL_BUILD_TESTS=ON -DOMNICAL_BUILD_BENCHMARKS=ON -DOMNICAL_WERROR=ON
-(cd "$build_dir" && ctest --output-on-failure -j "$jobs" "$@")
-
 sanitize_pass=${OMNICAL_SANITIZE_PASS:-core}
 case $sanitize_pass in
-  0) exit 0 ;;
+  0) ;;
   core) scope=(-DOMNICAL_CORE_ONLY=ON) ;;
   full) scope=(-DOMNICAL_CORE_ONLY=OFF) ;;
   *) echo "omnical: OMNICAL_SANITIZE_PASS must be core, full or 0, got '$sanitize_pass'" >&2; exit 2 ;;
 esac
+install_dependencies
+configure_and_build -DOMNICAL_BUILD_TESTS=ON -DOMNICAL_BUILD_BENCHMARKS=ON -DOMNICAL_WERROR=ON
+release_dir=$build_dir
+sanitize_dir=${OMNICAL_SANITIZE_BUILD_DIR:-$omnical_root/build/test-sanitize}
+
+if [ "$sanitize_pass" != 0 ]; then
+  sanitize_log=$release_dir/sanitize-build.log
+  echo "omnical: building the sanitizer tree ($sanitize_pass) beside the tests, at nice 19 (log: $sanitize_log)"
+  set -m  # its own process group, so a failure here stops the whole build (trap below)
+  (
+    renice -n 19 "$BASHPID" >/dev/null
+    build_dir=$sanitize_dir
+    configure_and_build -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE=-O1 -DOMNICAL_BUILD_TESTS=ON \
+      -DOMNICAL_BUILD_BENCHMARKS=OFF -DOMNICAL_WERROR=ON -DOMNICAL_SANITIZE=ON -DOMNICAL_PYTHON=OFF "${scope[@]}"
+  ) >"$sanitize_log" 2>&1 &
+  sanitize_build=$!
+  set +m
+  trap 'kill -- -"$sanitize_build" 2>/dev/null || true' EXIT
+fi
+(cd "$release_dir" && ctest --output-on-failure -j "$jobs" "$@")
+[ "$sanitize_pass" = 0 ] && exit 0
+
 echo "omnical: second pass under AddressSanitizer + UndefinedBehaviorSanitizer ($sanitize_pass)"
-build_dir=${OMNICAL_SANITIZE_BUILD_DIR:-$omnical_root/build/test-sanitize}
-configure_and_build -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE=-O1 -DOMNICAL_BUILD_TESTS=ON \
-  -DOMNICAL_BUILD_BENCHMARKS=OFF -DOMNICAL_WERROR=ON -DOMNICAL_SANITIZE=ON -DOMNICAL_PYTHON=OFF "${scope[@]}"
+if ! wait "$sanitize_build"; then
+  tail -40 "$sanitize_log" >&2
+  echo "omnical: the sanitizer build failed (log: $sanitize_log)" >&2
+  exit 1
+fi
+trap - EXIT
 # Any report fails the test that triggered it: UBSan does not recover (compile flag), ASan
 # aborts, leaks count.
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1
@@ -53,4 +78,4 @@ if [ "$sanitize_pass" = full ]; then
   too_slow+='|install.find_package_consumers|UnwarpedPanorama'
   too_slow+='|RecoversTheTruthFromExactObservations/hyperboloid_pinhole_aligned|RecordRoundTripsThroughCalibrationJson'
 fi
-(cd "$build_dir" && ctest --output-on-failure -j "$jobs" -LE 'bench|slow' -E "$too_slow" "$@")
+(cd "$sanitize_dir" && ctest --output-on-failure -j "$jobs" -LE 'bench|slow' -E "$too_slow" "$@")
