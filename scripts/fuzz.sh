@@ -14,18 +14,24 @@
 # as they were. Each run starts from the seeds and committed corpora, not from the last
 # run's build/fuzz/corpus. --targets a,b runs only those (after a fix in one parser): the
 # table keeps the other targets' rows from their last run (build/fuzz/results/<target>,
-# each row dated).
-# Usage: scripts/fuzz.sh [SECONDS | --runs N] [--targets T1,T2] [--update-corpus]
+# each row dated). A target that crashes, times out (20 s) or runs out of memory fails the
+# script after the others have run; its row says so and names the reproducer under
+# build/fuzz/crashes/, and its corpus is left as it was. --report-only writes the table
+# (and, with --update-corpus, merges the corpora) from the last run's results, fuzzing
+# nothing.
+# Usage: scripts/fuzz.sh [SECONDS | --runs N] [--targets T1,T2] [--update-corpus] [--report-only]
 set -euo pipefail
 seconds=60
 runs=""
 update_corpus=0
 chosen=""
+report_only=0
 while [ $# -gt 0 ]; do
   case $1 in
     --runs) runs=$2; shift 2 ;;
     --update-corpus) update_corpus=1; shift ;;
     --targets) chosen=$2; shift 2 ;;
+    --report-only) report_only=1; shift ;;
     *) seconds=$1; shift ;;
   esac
 done
@@ -84,7 +90,11 @@ done
 if [ -n "$runs" ]; then limit=(-runs="$runs"); limit_text="$runs executions"; else limit=(-max_total_time="$seconds"); limit_text="$seconds s"; fi
 
 mkdir -p "$build_dir/crashes" "$build_dir/corpus" "$build_dir/results"
-for target in "${targets[@]}"; do rm -rf "${build_dir:?}/corpus/$target" "$build_dir/results/$target"; done
+if [ "$report_only" = 0 ]; then
+  for target in "${targets[@]}"; do
+    rm -rf "${build_dir:?}/corpus/$target" "$build_dir/results/$target" "$build_dir/results/$target.failed"
+  done
+fi
 # One target: fuzz, then write "runs seconds corpus_size seeds date" to results/<target>
 # (nothing on a crash).
 fuzz_target() {
@@ -100,24 +110,42 @@ fuzz_target() {
   echo "$done_runs $((SECONDS - start)) $(ls "$corpus" | wc -l) $(ls "$seeds/$target" | wc -l) $(date -u +%Y-%m-%d)" \
     >"$build_dir/results/$target"
 }
-echo "fuzzing ${#targets[@]} targets for $limit_text each, $jobs at a time (logs: $build_dir/<target>.log)"
+if [ "$report_only" = 0 ]; then
+  echo "fuzzing ${#targets[@]} targets for $limit_text each, $jobs at a time (logs: $build_dir/<target>.log)"
+  for target in "${targets[@]}"; do
+    while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n || true; done
+    fuzz_target "$target" &
+  done
+  wait
+fi
+# A target without results: record what stopped it, from its log and artifact, for the table.
+failed=()
 for target in "${targets[@]}"; do
-  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n || true; done
-  fuzz_target "$target" &
+  [ -s "$build_dir/results/$target" ] && continue
+  log=$build_dir/$target.log
+  [ -s "$log" ] || continue
+  failed+=("$target")
+  echo "omnical: $target crashed or stopped early; see $log and $build_dir/crashes/" >&2
+  tail -30 "$log" >&2
+  artifact=$(ls -t "$build_dir/crashes/$target-"* 2>/dev/null | head -1 || true)
+  case $artifact in
+    *timeout*) kind=timeout ;;
+    *oom*) kind=out-of-memory ;;
+    "") kind=stopped ;;
+    *) kind=crash ;;
+  esac
+  units=$(sed -n 's/^stat::number_of_executed_units: *\([0-9]*\).*/\1/p' "$log")
+  echo "$kind ${units:-?} ${artifact:+build/fuzz/crashes/$(basename "$artifact")} $(date -u -r "$log" +%Y-%m-%d)" \
+    >"$build_dir/results/$target.failed"
 done
-wait
-failed=0
-for target in "${targets[@]}"; do
-  if [ ! -s "$build_dir/results/$target" ]; then
-    echo "omnical: $target crashed or stopped early; see $build_dir/$target.log and $build_dir/crashes/" >&2
-    tail -30 "$build_dir/$target.log" >&2
-    failed=1
-  fi
-done
-[ "$failed" = 0 ] || exit 1
 
 rows=()
 for target in "${all_targets[@]}"; do
+  if [ ! -s "$build_dir/results/$target" ] && [ -s "$build_dir/results/$target.failed" ]; then
+    read -r kind units artifact run_date <"$build_dir/results/$target.failed"
+    rows+=("| \`$target\` | | **$kind** after $units | | | | $run_date | **$kind**: \`$artifact\` |")
+    continue
+  fi
   if [ ! -s "$build_dir/results/$target" ]; then
     rows+=("| \`$target\` | | not run | | | | | |")
     continue
@@ -133,7 +161,7 @@ done
   echo "parsers of user files (\`tests/fuzz/fuzz_parsers.cc\`); the input is written to a file and"
   echo "read as the CLI reads it; refusing it with \`InputError\` is the only accepted answer."
   echo "Seeds: datasets-synthetic's files, small outputs of omnical itself and the committed minimized"
-  echo "corpora (\`tests/fuzz/corpus/<target>\`). Last run: \`scripts/fuzz.sh ${runs:+--runs }${runs:-$seconds}${chosen:+ --targets $chosen}\`"
+  echo "corpora (\`tests/fuzz/corpus/<target>\`). Last run: \`scripts/fuzz.sh $([ "$report_only" = 1 ] && echo "--report-only" || echo "${runs:+--runs }${runs:-$seconds}${chosen:+ --targets $chosen}")\`"
   echo "on $(date -u +%Y-%m-%d), $(nproc) cores, $jobs targets at a time; a row of a target it did not run is that target's last run's."
   echo
   echo "| target | seeds | executions survived | seconds | executions/s | corpus after | run on | result |"
@@ -145,8 +173,9 @@ echo "omnical: docs/fuzzing.md written"
 
 if [ "$update_corpus" = 1 ]; then
   for target in "${targets[@]}"; do
+    [ -s "$build_dir/results/$target" ] || continue  # a failed target's corpus stays as it was
     merged=$build_dir/merged/$target
-    rm -rf "$merged" && mkdir -p "$merged" "$committed/$target"
+    rm -rf "$merged" && mkdir -p "$merged" "$committed/$target" "$build_dir/corpus/$target"
     OMNICAL_FUZZ_TARGET=$target "$fuzzer" -merge=1 -max_len=16384 -rss_limit_mb=4096 -timeout=20 \
       "$merged" "$build_dir/corpus/$target" "$committed/$target" >"$build_dir/$target.merge.log" 2>&1
     # Replaced only by a merge that produced something.
@@ -157,3 +186,4 @@ if [ "$update_corpus" = 1 ]; then
     echo "$target: $(ls "$committed/$target" | wc -l) inputs, $(du -sk "$committed/$target" | cut -f1) KB in tests/fuzz/corpus/$target"
   done
 fi
+[ ${#failed[@]} -eq 0 ] || { echo "omnical: failed: ${failed[*]}" >&2; exit 1; }
