@@ -8,15 +8,13 @@
 # --update-corpus then replaces tests/fuzz/corpus/<target> with this run's corpus and the
 # committed one merged and minimized (libFuzzer -merge=1: the fewest inputs that keep
 # every feature reached; the generated seeds stay out, they are made anew each run).
-# A crash in one target fails the script once the others have run, with the reproducer
-# under build/fuzz/crashes/ (rerun: OMNICAL_FUZZ_TARGET=<target>
-# build/fuzz/tests/fuzz/omnical_fuzz FILE); docs/fuzzing.md and the corpora are then left
-# as they were. Each run starts from the seeds and committed corpora, not from the last
-# run's build/fuzz/corpus. --targets a,b runs only those (after a fix in one parser): the
-# table keeps the other targets' rows from their last run (build/fuzz/results/<target>,
-# each row dated). A target that crashes, times out (20 s) or runs out of memory fails the
-# script after the others have run; its row says so and names the reproducer under
-# build/fuzz/crashes/, and its corpus is left as it was. --report-only writes the table
+# A target that crashes, times out (20 s) or runs out of memory fails the script after the
+# others have run; its row in docs/fuzzing.md says so and names the reproducer under
+# build/fuzz/crashes/ (rerun: OMNICAL_FUZZ_TARGET=<target> build/fuzz/tests/fuzz/omnical_fuzz
+# FILE), and its committed corpus is left as it was. Each run starts from the seeds and
+# committed corpora, not from the last run's build/fuzz/corpus. --targets a,b runs only
+# those (after a fix in one parser): the table keeps the other targets' rows from their
+# last run (build/fuzz/results/<target>, each row dated). --report-only writes the table
 # (and, with --update-corpus, merges the corpora) from the last run's results, fuzzing
 # nothing.
 # Usage: scripts/fuzz.sh [SECONDS | --runs N] [--targets T1,T2] [--update-corpus] [--report-only]
