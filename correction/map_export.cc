@@ -91,47 +91,4 @@ void WriteNpyMaps(const RemapTable& table, const std::string& x_path, const std:
   WriteNpyFloat32(table, table.map_y, y_path);
 }
 
-// The largest virtual screen side omnical writes (remap --size allows 2..20000).
-constexpr int kMaxMapSidePx = 20000;
-
-RemapTable ReadOpenCvMaps(const std::string& float_path) {
-  cv::Mat map_x, map_y;
-  try {
-    cv::FileStorage fs(float_path, cv::FileStorage::READ);
-    if (!fs.isOpened()) throw InputError(InputMessage(float_path, "", "cannot be read (missing or not an OpenCV storage file)"));
-    // The header is checked before OpenCV allocates rows x cols: a damaged "cols" made it
-    // ask for 32 GB (found by tests/fuzz).
-    for (const char* name : {"map_x", "map_y"}) {
-      const cv::FileNode node = fs[name];
-      if (node.empty()) throw InputError(InputMessage(float_path, name, "missing"));
-      if (!node.isMap() || !node["rows"].isInt() || !node["cols"].isInt() || !node["data"].isSeq())
-        throw InputError(InputMessage(float_path, name, "not an OpenCV matrix (rows, cols, dt, data)"));
-      const int rows = static_cast<int>(node["rows"]), cols = static_cast<int>(node["cols"]);
-      if (rows < 1 || cols < 1 || rows > kMaxMapSidePx || cols > kMaxMapSidePx)
-        throw InputError(InputMessage(float_path, name, "rows and cols must be 1.." + std::to_string(kMaxMapSidePx)));
-      if (node["data"].size() != static_cast<size_t>(rows) * static_cast<size_t>(cols))
-        throw InputError(InputMessage(float_path, name, "data does not hold rows x cols values"));
-    }
-    fs["map_x"] >> map_x;
-    fs["map_y"] >> map_y;
-  } catch (const cv::Exception& e) {
-    throw InputError(InputMessage(float_path, "", std::string("cannot be parsed: ") + e.err));
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception& e) {
-    // OpenCV's parser also lets std::length_error out of damaged YAML (found by tests/fuzz).
-    throw InputError(InputMessage(float_path, "", std::string("cannot be parsed: ") + e.what()));
-  }
-  if (map_x.empty() || map_y.empty()) throw InputError(InputMessage(float_path, "map_x/map_y", "missing"));
-  if (map_x.type() != CV_32F || map_y.type() != CV_32F || map_x.size() != map_y.size())
-    throw InputError(InputMessage(float_path, "map_x/map_y", "not two float maps of one size"));
-  RemapTable table;
-  table.width = map_x.cols;
-  table.height = map_x.rows;
-  table.map_x.assign(map_x.begin<float>(), map_x.end<float>());
-  table.map_y.assign(map_y.begin<float>(), map_y.end<float>());
-  for (size_t i = 0; i < table.map_x.size(); ++i) table.valid_pixels += table.map_x[i] >= -0.5f && table.map_y[i] >= -0.5f;
-  return table;
-}
-
 }  // namespace omnical

@@ -11,7 +11,7 @@ jobs=${OMNICAL_JOBS:-$(nproc)}
 # Why each package is here: see docs/dependencies.md.
 omnical_packages=(
   g++ cmake ninja-build pkg-config
-  libeigen3-dev libceres-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libboost-dev
+  libeigen3-dev libceres-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libboost-dev zlib1g-dev
   libopencv-dev libopencv-contrib-dev libapriltag-dev
   libgtest-dev libgmock-dev libbenchmark-dev python3
   ffmpeg python3-numpy

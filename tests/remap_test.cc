@@ -3,7 +3,11 @@
 // path, and the error for objects elsewhere against the independent angle geometry.
 #include <gtest/gtest.h>
 
+#include <opencv2/core.hpp>
+
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <fstream>
 #include <iterator>
 #include <random>
@@ -341,6 +345,100 @@ TEST(MapExport, DamagedMapHeadersAreRefusedBeforeAllocating) {
   // YAML on which OpenCV's parser throws std::length_error (it escaped as "internal error").
   for (const char* name : {"maps_yml-32gb-alloc.yml", "maps_yml-length-error.yml"})
     EXPECT_THROW(ReadOpenCvMaps(testing::SourceDir() + "/tests/data/fuzz-crashes/" + name), InputError) << name;
+}
+
+// The strict reader (opencv_maps_reader.cc) against OpenCV's own: every value cv::FileStorage
+// writes, plain or gzip, reads back to the same float bits as cv::FileStorage reads it
+// (exact: both parse the decimal text as a double and round it to float).
+TEST(MapExport, StrictReaderReadsWhatOpenCvWritesToTheBit) {
+  const std::string dir = testing::PrivateTempDir();
+  cv::Mat map_x(7, 13, CV_32F), map_y(7, 13, CV_32F);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> pixel(-1.0f, 4000.0f);
+  for (int i = 0; i < map_x.rows * map_x.cols; ++i) {
+    map_x.at<float>(i) = pixel(random);
+    map_y.at<float>(i) = std::ldexp(pixel(random), static_cast<int>(random() % 240) - 140);  // subnormal to 1e34
+  }
+  map_x.at<float>(0) = -1.0f;  // what remap writes where no mirror is seen
+  map_y.at<float>(1) = 1e-41f;  // subnormal
+  map_y.at<float>(2) = std::numeric_limits<float>::max();
+  for (const std::string name : {"maps.yml", "maps.yml.gz"}) {
+    const std::string path = dir + "/" + name;
+    {
+      cv::FileStorage fs(path, cv::FileStorage::WRITE);
+      fs << "map_x" << map_x << "map_y" << map_y;
+    }
+    cv::Mat opencv_x, opencv_y;
+    {
+      cv::FileStorage fs(path, cv::FileStorage::READ);
+      fs["map_x"] >> opencv_x;
+      fs["map_y"] >> opencv_y;
+    }
+    const RemapTable table = ReadOpenCvMaps(path);
+    ASSERT_EQ(table.width, 13);
+    ASSERT_EQ(table.height, 7);
+    EXPECT_EQ(table.valid_pixels, 7 * 13 - 1);
+    for (int i = 0; i < 7 * 13; ++i) {
+      EXPECT_EQ(std::memcmp(&table.map_x[i], &opencv_x.at<float>(i), 4), 0) << name << " map_x " << i;
+      EXPECT_EQ(std::memcmp(&table.map_y[i], &opencv_y.at<float>(i), 4), 0) << name << " map_y " << i;
+    }
+  }
+}
+
+// Damaged maps files: each refused with InputError naming the file and the matrix or line,
+// never a hang (the first case hangs cv::FileStorage 4.6 forever: tests/fuzz, maps_yml).
+TEST(MapExport, DamagedMapsFilesAreRefusedNamingFieldOrLine) {
+  const std::string dir = testing::PrivateTempDir();
+  const std::string head = "%YAML:1.0\n---\n";
+  const std::string map_y = "map_y: !!opencv-matrix\n   rows: 1\n   cols: 2\n   dt: f\n   data: [ 1., 2. ]\n";
+  const std::string long_line(5000, ' ');
+  const std::pair<std::string, std::string> cases[] = {
+      {"map_x: !!opencv-matrix\n   rows: 1\n   cols: 2\n   dt: f\n   data: [ .Nan, 2. ]\n" + map_y, "map_x.data: value 1 is not a finite number"},
+      {"map_x: !!opencv-matrix\n   rows: 1\n   cols: 2\n   dt: f\n   data: [ 1., 3.5e38 ]\n" + map_y, "map_x.data: value 2 is not a finite number"},
+      {"map_x: !!opencv-matrix\n   rows: 1\n   cols: 2\n   dt: d\n   data: [ 1., 2. ]\n" + map_y, "map_x.dt: must be f"},
+      {"map_x: !!opencv-matrix\n   rows: 1\n   cols: 2\n   dt: f\n   data: [ 1., 2., 3. ]\n" + map_y, "map_x.data: holds more than rows x cols = 2"},
+      {"map_x: !!opencv-matrix\n   rows: 1\n   cols: 2\n   dt: f\n   data: [ 1.,, 2. ]\n" + map_y, "map_x.data: an empty value after value 1"},
+      {"map_x: !!opencv-matrix\n   rows: 1\n   cols: 2\n   dt: f\n   data: [ 1., 2. ] x\n" + map_y, "line 7: map_x.data: text after the closing"},
+      {"map_x: !!opencv-matrix\n   rows: 1\n   cols: 2\n   dt: f\n   data: [ 1.,\n", "map_x.data: ends before its closing"},
+      {"map_x: !!opencv-matrix\n   rows: 1\n   cols: 0\n", "map_x.cols: must be a whole number 1..20000"},
+      {"map_x: !!opencv-matrix\n   cols: 2\n", "line 4: map_x: expected `rows:`"},
+      {"map_x: !!opencv-matrix\n   rows: 1\n   cols: 3\n   dt: f\n   data: [ 1., 2., 3. ]\n" + map_y, "map_x/map_y: not two maps of one size"},
+      {map_y, "map_x: missing"},
+      {map_y + map_y, "line 8: map_y appears twice"},
+      {map_y + "map_x: [ 1, 2 ]\n", "line 8: expected `NAME: !!opencv-matrix`"},
+      {map_y + "map_x: !!opencv-matrix\n   rows: 1\n" + long_line + "\n", "line 10: is longer than 4096 bytes"},
+      {map_y + std::string("map_x\0: x\n", 10), "line 8: holds a NUL byte"},
+  };
+  for (const auto& [text, expected] : cases) {
+    std::ofstream(dir + "/maps.yml", std::ios::binary) << head << text;
+    try {
+      ReadOpenCvMaps(dir + "/maps.yml");
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find(dir + "/maps.yml: "), std::string::npos) << error.what();
+      EXPECT_NE(std::string(error.what()).find(expected), std::string::npos) << error.what() << "\nexpected: " << expected;
+    }
+  }
+  // A gzip stream cut short (a half-copied maps.yml.gz) and a file that is not YAML.
+  const RemapTable table = BuildRemapTable(Shipped("ohte-sph"), [] {
+    RemapSettings settings;
+    settings.screen = AllScreens()[0];
+    return settings;
+  }());
+  WriteOpenCvMaps(table, dir + "/maps.yml.gz", dir + "/maps_fixed.yml.gz");
+  std::ifstream whole(dir + "/maps.yml.gz", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(whole)), std::istreambuf_iterator<char>());
+  std::ofstream(dir + "/cut.yml.gz", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  EXPECT_THROW(ReadOpenCvMaps(dir + "/cut.yml.gz"), InputError);
+  std::ofstream(dir + "/not.yml") << "P5\n2 2\n255\n";
+  try {
+    ReadOpenCvMaps(dir + "/not.yml");
+    ADD_FAILURE() << "accepted a PGM";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("not an OpenCV YAML storage file"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW(ReadOpenCvMaps(dir + "/absent.yml.gz"), InputError);
+  EXPECT_THROW(ReadOpenCvMaps(testing::SourceDir() + "/tests/data/fuzz-crashes/maps_yml-opencv-filestorage-hang.yml"), InputError);
 }
 
 }  // namespace
