@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "calib/fit_covariance.h"
+#include "calib/parallel_evaluation.h"
 #include "calib/reprojection_cost.h"
 #include "calib/sensor_blocks.h"
 #include "calib/shape_smoothness.h"
@@ -93,7 +94,7 @@ class FitRun {
   FitRun(const Model& guess, const CalibrationTarget& target, const DetectionSet& detections,
          const std::vector<TargetPose>& initial_poses, const FitOptions& options)
       : guess_(guess), detections_(detections), options_(options), blocks_(guess), views_(detections.images.size()),
-        problem_(ProblemOptions()), progress_(options.progress, "fit", 0), iteration_progress_(&progress_) {
+        evaluation_(options.threads), problem_(ProblemOptions(options.threads > 1 ? &evaluation_ : nullptr)), progress_(options.progress, "fit", 0), iteration_progress_(&progress_) {
     with_warp_ = options.fit_board_warp || !options.board_warp.IsZero();
     warp_mm_ = {options.board_warp.x_mm, options.board_warp.y_mm};
     result_.guess_rim_radius_mm = guess.rim_radius_mm;
@@ -142,9 +143,10 @@ class FitRun {
     double scale;              // internal -> reported units
   };
 
-  static ceres::Problem::Options ProblemOptions() {
+  static ceres::Problem::Options ProblemOptions(ceres::EvaluationCallback* evaluation) {
     ceres::Problem::Options problem_options;
     problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    problem_options.evaluation_callback = evaluation;
     return problem_options;
   }
 
@@ -177,8 +179,9 @@ class FitRun {
           ++result_.dropped;  // not projectable at the initial guess
           continue;
         }
-        const ceres::ResidualBlockId id =
-            problem_.AddResidualBlock(Cost::Create(guess_, point->second, image.corners[i].pixel, basis), loss_.get(), blocks);
+        ceres::CostFunction* cost = Cost::Create(guess_, point->second, image.corners[i].pixel, basis);
+        if (options_.threads > 1) cost = evaluation_.Wrap(cost, blocks);
+        const ceres::ResidualBlockId id = problem_.AddResidualBlock(cost, loss_.get(), blocks);
         residuals_.push_back({v, i, std::move(functor), blocks, id});
         ++view_residuals_[v];
       }
@@ -340,6 +343,7 @@ class FitRun {
       options.gradient_tolerance = std::max(solver_.gradient_tolerance, defaults.gradient_tolerance);
       options.parameter_tolerance = std::max(solver_.parameter_tolerance, defaults.parameter_tolerance);
     }
+    if (options_.threads > 1) evaluation_.UpdateConstantBlocks(problem_);
     ceres::Solve(options, &problem_, &summary_);
     progress_.ThrowIfCancelled();
   }
@@ -629,6 +633,7 @@ class FitRun {
   std::array<double, 2> warp_mm_{{0.0, 0.0}};
   std::map<int, Eigen::Vector2d> warp_basis_;
   std::unique_ptr<ceres::LossFunctionWrapper> loss_;
+  ParallelEvaluation evaluation_;  // before the problem: its costs forget themselves here
   ceres::Problem problem_;
   std::vector<Residual> residuals_;
   std::vector<size_t> view_residuals_;

@@ -192,6 +192,7 @@ FitOptions FitOptionsFor(const CalibrationInput& input, const CalibrationOptions
   fit.robust_loss_px = options.loss_px;
   fit.fit_board_warp = options.board_warp;
   fit.solver.max_num_iterations = options.max_iterations;
+  fit.threads = options.threads;
   if (const std::string why = fit.Check(); !why.empty()) throw InputError(why);
   fit.tolerances = ExpandTolerances(input.guess_tolerances);
   for (auto it = fit.tolerances.begin(); it != fit.tolerances.end();) {

@@ -49,7 +49,7 @@ struct CalibrationOptions {
   double loss_px = 1.0;
   int max_iterations = 200;
   int detection_passes = 2;
-  int threads = 1;  // detection and the board-size checks
+  int threads = 1;  // detection, the board-size checks and the fit's Jacobians (the same result for any count)
   bool leave_one_out = false;
   // Generalisation (calib/cross_validation.h): views kept out of the fit (spread evenly
   // over the input) and evaluated with the sensor held; the usable views split in two

@@ -126,6 +126,7 @@ std::string FitOptions::Check() const {
   if (!(outlier_floor_px >= 0.0) || !(outlier_sigmas > 0.0) || !(view_rms_ratio > 1.0))
     return "outlier rule: outlier_floor_px >= 0, outlier_sigmas > 0 and view_rms_ratio > 1";
   if (solver.max_num_iterations < 1) return "max_iterations: must be >= 1";
+  if (threads < 1) return "threads: must be >= 1";
   if (!std::isfinite(board_warp.x_mm) || !std::isfinite(board_warp.y_mm)) return "board_warp: must be finite";
   if (std::string why; !solver.IsValid(&why)) return "solver: " + why;
   return {};

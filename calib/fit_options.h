@@ -59,6 +59,9 @@ struct FitOptions {
   double robust_loss_px = 1.0;  // robust scale in px (Cauchy, outlier removal, then Huber); 0 = plain least squares
   ceres::Solver::Options solver = DefaultSolverOptions();  // max_num_iterations is per stage
   bool compute_covariance = true;
+  // Threads computing the corners' residuals and Jacobians (calib/parallel_evaluation.h);
+  // Ceres' own work stays on one (solver.num_threads), so the fit is the same for any count.
+  int threads = 1;
   // Outliers (robust mode): |residual| beyond max(outlier_floor_px, outlier_sigmas x a
   // robust sigma of the residuals) are removed. The floor keeps a very good fit (renders:
   // 0.02 px) from throwing good corners away; 4 sigma of a 2-D Gaussian's |e| cuts 3e-4.

@@ -20,6 +20,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cstring>
+#include <numeric>
 #include <optional>
 #include <vector>
 
@@ -36,7 +38,11 @@ class ReprojectionCost {
   // warp_basis: the corner's BoardWarp::Basis when the warp block is present.
   ReprojectionCost(const Model& base, const Eigen::Vector3d& point_in_target_mm, const Eigen::Vector2d& observed_px,
                    const std::optional<Eigen::Vector2d>& warp_basis = std::nullopt)
-      : base_(base), point_in_target_mm_(point_in_target_mm), observed_px_(observed_px), warp_basis_(warp_basis) {
+      : base_(base),
+        point_in_target_mm_(point_in_target_mm),
+        observed_px_(observed_px),
+        warp_basis_(warp_basis),
+        block_sizes_(BlockSizes(base, warp_basis.has_value())) {
     // The corner was detected, so its reflection lies on the mirror; iterates may stray a
     // little past the rim, where the profile is still defined.
     base_.rim_radius_mm = std::min(1.15 * base.rim_radius_mm, 0.99 * base.mirror.MaxRadiusMm());
@@ -58,7 +64,8 @@ class ReprojectionCost {
     const Vec3<T> in_camera = rotation * in_target + Vec3<T>(p[next + 1][0], p[next + 1][1], p[next + 1][2]);
     Vec3<T> mirror_point;
     // The corner was detected: no image-bounds or occlusion test, only the optics.
-    if (model.ReflectionPoint(in_camera, &mirror_point) != ProjectionStatus::kOk) return false;
+    solved_.reuse = SameScalarsAsLastCall(p);
+    if (model.ReflectionPoint(in_camera, &mirror_point, nullptr, &solved_) != ProjectionStatus::kOk) return false;
     Vec2<T> pixel;
     if (!model.lens.ProjectToPixel(mirror_point, &pixel)) return false;
     residual[0] = pixel(0) - T(observed_px_.x());
@@ -92,10 +99,34 @@ class ReprojectionCost {
  private:
   bool HasShape() const { return base_.mirror.NumParams() > 0; }
 
+  // Whether the parameters' values (a Jet's scalar part) are those of the last call, which
+  // are then kept for the next. The parameters determine everything the solve sees.
+  template <typename T>
+  bool SameScalarsAsLastCall(T const* const* p) const {
+    size_t k = 0;
+    bool same = !last_scalars_.empty();
+    last_scalars_.resize(std::accumulate(block_sizes_.begin(), block_sizes_.end(), size_t{0}));
+    for (size_t b = 0; b < block_sizes_.size(); ++b)
+      for (int i = 0; i < block_sizes_[b]; ++i, ++k) {
+        const double value = ScalarPart(p[b][i]);
+        // Bitwise: -0.0 and 0.0 may take different branches, and NaN never equals itself.
+        same = same && std::memcmp(&value, &last_scalars_[k], sizeof value) == 0;
+        last_scalars_[k] = value;
+      }
+    return same;
+  }
+
   Model base_;
   Eigen::Vector3d point_in_target_mm_;
   Eigen::Vector2d observed_px_;
   std::optional<Eigen::Vector2d> warp_basis_;
+  std::vector<int> block_sizes_;
+  // The last call's parameter values and reflection point (model/catadioptric.h,
+  // SolvedReflection): the Jet passes of one Jacobian, and a Jacobian after a plain residual
+  // at the same point, solve once. Mutable state in a cost is safe: each corner has its own
+  // cost, evaluated by one thread at a time (Ceres, calib/parallel_evaluation.h).
+  mutable std::vector<double> last_scalars_;
+  mutable SolvedReflection solved_;
 };
 
 // The cost of a model type. Deduced from the Catadioptric's own template arguments: clang

@@ -38,6 +38,18 @@ struct ProjectionCache {
   AxialGuessTable guess;
 };
 
+// A solved reflection point kept by a caller that projects the same point through the
+// same model again: automatic derivatives evaluate a cost in several passes (8 derivatives
+// each) with identical scalar parts, and a solver's plain residual comes before its
+// Jacobian at the same parameters. Only the caller knows the inputs are unchanged, so it
+// says so (reuse); the answer is then bit-identical to solving again, minus the solve.
+struct SolvedReflection {
+  Eigen::Vector2d q_mm = Eigen::Vector2d::Zero();  // the reflection point, mirror frame
+  Eigen::Matrix2d fermat_jacobian = Eigen::Matrix2d::Zero();  // dF/dq at q_mm (the Jet step's)
+  bool has_q = false, has_jacobian = false;
+  bool reuse = false;  // set by the caller: same point, same model as the solve that filled it
+};
+
 template <typename T, template <typename> class Profile, template <typename> class Lens>
 struct Catadioptric {
   using Scalar = T;
@@ -91,8 +103,10 @@ struct Catadioptric {
   }
 
   // Reflection point on the mirror (camera frame, mm) of the ray that images the point.
+  // solved (optional): filled with the solve's root; with solved->reuse, that root is
+  // taken instead of solving.
   ProjectionStatus ReflectionPoint(const Vec3<T>& point_in_camera, Vec3<T>* mirror_point_in_camera,
-                                   const ProjectionCache* cache = nullptr) const;
+                                   const ProjectionCache* cache = nullptr, SolvedReflection* solved = nullptr) const;
 
   // Pixel of a point given in the camera frame (mm).
   ProjectionStatus Project(const Vec3<T>& point_in_camera, Vec2<T>* pixel,
@@ -315,7 +329,7 @@ template <typename T, template <typename> class Profile, template <typename> cla
 ProjectionStatus ReflectionPointImpl(const Catadioptric<T, Profile, Lens>& model,
                                      const Catadioptric<double, Profile, Lens>& model_d,
                                      const Vec3<T>& point_in_camera, Vec3<T>* mirror_point_in_camera,
-                                     const ProjectionCache* cache) {
+                                     const ProjectionCache* cache, SolvedReflection* solved) {
   constexpr bool kJet = !std::is_same_v<T, double>;
   constexpr bool kOrtho = Lens<T>::kIsOrthographic;
   const Eigen::Vector3d point_d = ToDouble(point_in_camera);
@@ -343,7 +357,11 @@ ProjectionStatus ReflectionPointImpl(const Catadioptric<T, Profile, Lens>& model
                                         : Eigen::Vector3d(-(rotation_d.transpose() * translation_d));
   Eigen::Vector2d q;
   Eigen::Matrix2d jacobian;
-  if (axial) {
+  const bool reuse = solved != nullptr && solved->reuse && solved->has_q;
+  if (solved != nullptr && !reuse) *solved = SolvedReflection{};  // a failed solve leaves nothing to reuse
+  if (reuse) {
+    q = solved->q_mm;
+  } else if (axial) {
     double x = 0.0, dg_dx = 0.0;
     const ProjectionStatus status =
         SolveAxialRadius(kOrtho, model_d.pose.m_mm, model_d.mirror, rim, rho, p.z(), guess, &x, &dg_dx);
@@ -354,13 +372,19 @@ ProjectionStatus ReflectionPointImpl(const Catadioptric<T, Profile, Lens>& model
     const ProjectionStatus status = SolveFermatPoint<kOrtho>(lens_d, model_d.mirror, rim, p, seed, &q, &jacobian);
     if (status != ProjectionStatus::kOk) return status;
   }
+  if (solved != nullptr && !reuse) *solved = SolvedReflection{q, Eigen::Matrix2d::Zero(), true, false, false};
   // 2. The mirror point in the camera frame. Jets always take the general 2-D
   // implicit-function step, so tilt and decenter get their derivatives even at 0.
   if constexpr (kJet) {
     // The Jacobian at the root itself (the solvers' last one is one step before it).
-    const FermatReflection at_root = EvaluateFermatReflection<kOrtho>(lens_d.x(), lens_d.y(), lens_d.z(),
-                                                                      model_d.mirror, p.x(), p.y(), p.z(), q.x(), q.y());
-    jacobian << at_root.j_xx, at_root.j_xy, at_root.j_xy, at_root.j_yy;
+    if (reuse && solved->has_jacobian) {
+      jacobian = solved->fermat_jacobian;
+    } else {
+      const FermatReflection at_root = EvaluateFermatReflection<kOrtho>(
+          lens_d.x(), lens_d.y(), lens_d.z(), model_d.mirror, p.x(), p.y(), p.z(), q.x(), q.y());
+      jacobian << at_root.j_xx, at_root.j_xy, at_root.j_xy, at_root.j_yy;
+      if (solved != nullptr) solved->fermat_jacobian = jacobian, solved->has_jacobian = true;
+    }
     const Mat3<T> rotation = model.pose.CameraFromMirrorRotation();
     const Vec3<T> translation = model.pose.CameraFromMirrorTranslation();
     const Vec3<T> point_in_mirror = rotation.transpose() * (point_in_camera - translation);
@@ -430,11 +454,12 @@ ProjectionStatus UnprojectImpl(const Catadioptric<T, Profile, Lens>& model,
 template <typename T, template <typename> class Profile, template <typename> class Lens>
 ProjectionStatus Catadioptric<T, Profile, Lens>::ReflectionPoint(const Vec3<T>& point_in_camera,
                                                                  Vec3<T>* mirror_point_in_camera,
-                                                                 const ProjectionCache* cache) const {
+                                                                 const ProjectionCache* cache,
+                                                                 SolvedReflection* solved) const {
   if constexpr (std::is_same_v<T, double>) {
-    return detail::ReflectionPointImpl(*this, *this, point_in_camera, mirror_point_in_camera, cache);
+    return detail::ReflectionPointImpl(*this, *this, point_in_camera, mirror_point_in_camera, cache, solved);
   } else {
-    return detail::ReflectionPointImpl(*this, Cast<double>(), point_in_camera, mirror_point_in_camera, cache);
+    return detail::ReflectionPointImpl(*this, Cast<double>(), point_in_camera, mirror_point_in_camera, cache, solved);
   }
 }
 

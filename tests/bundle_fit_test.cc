@@ -4,8 +4,10 @@
 // RMS < 1e-6 px. This isolates the optimiser (and the Jet derivatives it runs on).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <random>
 
 #include "calib/board_warp.h"
@@ -14,6 +16,8 @@
 #include "calib/knot_choice.h"
 #include "calib/predicted_error.h"
 #include "calib/projection_diff.h"
+#include "calib/reprojection_cost.h"
+#include "calib/sensor_blocks.h"
 #include "calib/synthetic/renderer.h"
 #include "test_sensors.h"
 #include "model/io/sensor_yaml.h"
@@ -305,6 +309,104 @@ TEST(BundleFit, BoardWarpStandardDeviationsHoldUnderNoise) {
   EXPECT_LT(std::abs(fit.board_warp->warp.x_mm - 3.0), 4.0 * fit.board_warp->std_x_mm) << fit.board_warp->std_x_mm;
   EXPECT_LT(std::abs(fit.board_warp->warp.y_mm + 2.0), 4.0 * fit.board_warp->std_y_mm) << fit.board_warp->std_y_mm;
   EXPECT_LT(fit.board_warp->std_x_mm, 1.0);  // determined: the 3 mm sag is measured, not guessed
+}
+
+// The fit's corners evaluated on several threads (calib/parallel_evaluation.h) give the
+// very numbers one thread gives: bit for bit, through noise, outlier removal (residual
+// blocks removed mid-fit) and the covariance. A stale cache, or a thread-dependent sum,
+// would differ in the last digits at least.
+TEST(BundleFit, ThreadCountChangesNoDigit) {
+  const Truth truth = ExactObservations(LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-sph-misaligned.yaml"));
+  const Sensor guess = Perturbed(truth.sensor);
+  DetectionSet noisy = truth.detections;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.3);
+  int corner = 0;
+  for (ImageDetections& image : noisy.images)
+    for (CornerObservation& c : image.corners) {
+      c.pixel += Eigen::Vector2d(noise(rng), noise(rng));
+      if (++corner % 37 == 0) c.pixel.x() += 25.0;  // gross outliers, removed mid-fit
+    }
+  const std::vector<TargetPose> poses = StartingPoses(guess, {truth.sensor, truth.target, noisy});
+  FitOptions options = FitOptions::DefaultsFor(guess);
+  const FitResult one = FitSensor(guess, truth.target, noisy, poses, options);
+  options.threads = 3;
+  const FitResult three = FitSensor(guess, truth.target, noisy, poses, options);
+  ASSERT_TRUE(one.sensor.has_value() && three.sensor.has_value());
+  ASSERT_TRUE(one.covariance_ok && three.covariance_ok);
+  EXPECT_GT(one.outliers, 10);
+  EXPECT_EQ(one.outliers, three.outliers);
+  EXPECT_EQ(one.rms_px, three.rms_px);
+  EXPECT_EQ(one.solver_report, three.solver_report);
+  ASSERT_EQ(one.parameters.size(), three.parameters.size());
+  for (size_t k = 0; k < one.parameters.size(); ++k) {
+    EXPECT_EQ(one.parameters[k].value, three.parameters[k].value) << one.parameters[k].name;
+    EXPECT_EQ(one.parameters[k].std, three.parameters[k].std) << one.parameters[k].name;
+  }
+  for (size_t v = 0; v < one.poses.size(); ++v)
+    EXPECT_EQ(one.poses[v].camera_from_target_translation_mm, three.poses[v].camera_from_target_translation_mm) << v;
+}
+
+// The cost keeps the last reflection point to skip the solve in the Jet passes that share
+// its parameter values (model/catadioptric.h, SolvedReflection). Whatever it evaluated
+// before, its residual and Jacobian must be those of a fresh cost, bit for bit.
+TEST(ReprojectionCost, AnswersAsAFreshCostWhateverItEvaluatedBefore) {
+  using Model = Catadioptric<double, SphereProfile, PinholeLens>;
+  const Sensor sensor = LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-sph-misaligned.yaml");
+  const Model& model = std::get<Model>(sensor.model());
+  const Truth truth = ExactObservations(sensor);
+  const ImageDetections& image = truth.detections.images[0];
+  TargetPose pose;
+  ASSERT_TRUE(InitialTargetPose(sensor, truth.target, image, &pose));
+  SensorBlocks<Model> blocks(model);
+  const Eigen::Quaterniond& q = pose.camera_from_target_rotation;
+  std::array<double, 4> rotation = {q.x(), q.y(), q.z(), q.w()};
+  std::array<double, 3> translation = {pose.camera_from_target_translation_mm.x(), pose.camera_from_target_translation_mm.y(),
+                                       pose.camera_from_target_translation_mm.z()};
+  std::vector<double*> parameters = blocks.Pointers();
+  parameters.push_back(rotation.data());
+  parameters.push_back(translation.data());
+  const std::vector<int> sizes = ReprojectionCost<SphereProfile, PinholeLens>::BlockSizes(model);
+  ASSERT_EQ(sizes.size(), parameters.size());
+  const auto found = std::find_if(truth.target.corners().begin(), truth.target.corners().end(),
+                                  [&](const TargetCorner& c) { return c.id == image.corners[5].id; });
+  ASSERT_NE(found, truth.target.corners().end());
+  const Eigen::Vector3d corner = found->point_in_target;
+  struct Answer {
+    std::array<double, 2> residual;
+    std::vector<std::vector<double>> jacobians;
+  };
+  auto evaluate = [&](const ceres::CostFunction& cost, bool with_jacobians) {
+    Answer answer;
+    std::vector<double*> jacobians;
+    for (int size : sizes) answer.jacobians.emplace_back(2 * size, NAN);
+    for (auto& j : answer.jacobians) jacobians.push_back(j.data());
+    EXPECT_TRUE(cost.Evaluate(parameters.data(), answer.residual.data(), with_jacobians ? jacobians.data() : nullptr));
+    return answer;
+  };
+  const std::unique_ptr<ceres::CostFunction> fresh(
+      ReprojectionCost<SphereProfile, PinholeLens>::Create(model, corner, image.corners[5].pixel));
+  const Answer expected = evaluate(*fresh, true);
+  // A plain residual takes the double root itself, a Jacobian one more Newton step in Jets:
+  // the two agree to rounding only, so each is compared with its own kind.
+  const std::unique_ptr<ceres::CostFunction> fresh_plain(
+      ReprojectionCost<SphereProfile, PinholeLens>::Create(model, corner, image.corners[5].pixel));
+  const Answer expected_plain = evaluate(*fresh_plain, false);
+  const std::unique_ptr<ceres::CostFunction> used(
+      ReprojectionCost<SphereProfile, PinholeLens>::Create(model, corner, image.corners[5].pixel));
+  // Elsewhere first (another m and tilt), then a plain residual, then twice the Jacobian.
+  const double m = parameters[1][0], tilt = parameters[2][0];
+  parameters[1][0] += 0.7, parameters[2][0] += 0.01;
+  evaluate(*used, true);
+  parameters[1][0] = m, parameters[2][0] = tilt;
+  const Answer plain = evaluate(*used, false);
+  EXPECT_EQ(plain.residual, expected_plain.residual);
+  for (int pass = 0; pass < 2; ++pass) {
+    const Answer again = evaluate(*used, true);
+    EXPECT_EQ(again.residual, expected.residual) << pass;
+    EXPECT_EQ(again.jacobians, expected.jacobians) << pass;
+  }
+  EXPECT_NE(expected.jacobians[1][0], 0.0);  // m moves the pixel
 }
 
 TEST(RefineOptions, HoldsBlocksByTheirNamesAndRejectsUnknownOnes) {

@@ -93,7 +93,7 @@ Command CalibrateCommand() {
                            "Without a guess: the rim ray's angle from the mirror axis (Omega, deg) to start from")
                 ->check(CLI::Range(10.0, 170.0))->capture_default_str();
             library.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-            sub.add_option("--threads", library.threads, "Detection threads")->check(CLI::Range(1, 256))->capture_default_str();
+            sub.add_option("--threads", library.threads, "Threads: detection, board checks and the fit's Jacobians (the result is the same for any count)")->check(CLI::Range(1, 256))->capture_default_str();
             sub.add_option("--out", options->out_dir, "Output directory")->required();
             sub.add_option("--fix", options->fix, "Blocks held constant: lens, lens_scale, principal_point, distortion, m, tilt, decenter, shape, poses");
             sub.add_option("--loss-px", library.loss_px, "Huber loss scale, px (0: least squares)")
