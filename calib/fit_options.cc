@@ -127,6 +127,8 @@ std::string FitOptions::Check() const {
     return "outlier rule: outlier_floor_px >= 0, outlier_sigmas > 0 and view_rms_ratio > 1";
   if (solver.max_num_iterations < 1) return "max_iterations: must be >= 1";
   if (threads < 1) return "threads: must be >= 1";
+  // The threads work through an evaluation callback, which Ceres refuses with inner iterations.
+  if (threads > 1 && solver.use_inner_iterations) return "threads: more than 1 needs solver.use_inner_iterations off";
   if (!std::isfinite(board_warp.x_mm) || !std::isfinite(board_warp.y_mm)) return "board_warp: must be finite";
   if (std::string why; !solver.IsValid(&why)) return "solver: " + why;
   return {};

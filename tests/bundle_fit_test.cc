@@ -438,6 +438,12 @@ TEST(FitOptions, CheckRefusesInvalidSolverSettings) {
   options = FitOptions();
   options.solver.function_tolerance = -1.0;
   EXPECT_EQ(options.Check().rfind("solver: ", 0), 0u) << options.Check();
+  options = FitOptions();
+  options.threads = 0;
+  EXPECT_EQ(options.Check(), "threads: must be >= 1");
+  options.threads = 2;
+  options.solver.use_inner_iterations = true;
+  EXPECT_EQ(options.Check(), "threads: more than 1 needs solver.use_inner_iterations off");
 }
 
 // The spline's knot count by held-out folds (calib/knot_choice.h), on corners with 0.1 px
