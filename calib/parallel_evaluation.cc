@@ -10,8 +10,8 @@ namespace omnical {
 
 class ParallelEvaluation::CachedCost : public ceres::CostFunction {
  public:
-  CachedCost(ParallelEvaluation* owner, ceres::CostFunction* inner, const std::vector<double*>& parameters)
-      : owner_(owner), inner_(inner), parameters_(parameters) {
+  CachedCost(ParallelEvaluation* owner, size_t index, ceres::CostFunction* inner, const std::vector<double*>& parameters)
+      : owner_(owner), index_(index), inner_(inner), parameters_(parameters) {
     set_num_residuals(inner->num_residuals());
     *mutable_parameter_block_sizes() = inner->parameter_block_sizes();
     compute_jacobian_.assign(parameters.size(), true);
@@ -26,12 +26,21 @@ class ParallelEvaluation::CachedCost : public ceres::CostFunction {
   }
   ~CachedCost() override { owner_->Forget(this); }
 
+  size_t index() const { return index_; }
+  void set_index(size_t index) { index_ = index; }
+
   void UpdateConstantBlocks(const ceres::Problem& problem) {
-    for (size_t b = 0; b < parameters_.size(); ++b) compute_jacobian_[b] = !problem.IsParameterBlockConstant(parameters_[b]);
+    for (size_t b = 0; b < parameters_.size(); ++b) {
+      const bool variable = !problem.IsParameterBlockConstant(parameters_[b]);
+      // A block that was constant has no Jacobian in the cache.
+      if (variable != compute_jacobian_[b]) state_ = State::kEmpty;
+      compute_jacobian_[b] = variable;
+    }
   }
 
   // Evaluates at the current values of the parameter blocks, into the cache.
   void Compute(bool with_jacobians) {
+    state_ = State::kEmpty;  // until the evaluation below has filled it
     size_t k = 0;
     for (size_t b = 0; b < parameters_.size(); ++b)
       for (int32_t i = 0; i < parameter_block_sizes()[b]; ++i) values_[k++] = parameters_[b][i];
@@ -75,6 +84,7 @@ class ParallelEvaluation::CachedCost : public ceres::CostFunction {
   }
 
   ParallelEvaluation* owner_;
+  size_t index_;  // in owner_->costs_
   std::unique_ptr<ceres::CostFunction> inner_;
   std::vector<double*> parameters_;
   std::vector<bool> compute_jacobian_;
@@ -85,13 +95,17 @@ class ParallelEvaluation::CachedCost : public ceres::CostFunction {
 };
 
 ceres::CostFunction* ParallelEvaluation::Wrap(ceres::CostFunction* cost, const std::vector<double*>& parameters) {
-  auto* cached = new CachedCost(this, cost, parameters);
+  auto* cached = new CachedCost(this, costs_.size(), cost, parameters);
   costs_.push_back(cached);
   return cached;
 }
 
 void ParallelEvaluation::Forget(const CachedCost* cost) {
-  costs_.erase(std::remove(costs_.begin(), costs_.end(), cost), costs_.end());
+  // The last one takes its place: the order of computing does not change any value.
+  CachedCost* last = costs_.back();
+  costs_[cost->index()] = last;
+  last->set_index(cost->index());
+  costs_.pop_back();
 }
 
 void ParallelEvaluation::UpdateConstantBlocks(const ceres::Problem& problem) {

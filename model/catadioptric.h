@@ -332,6 +332,8 @@ ProjectionStatus ReflectionPointImpl(const Catadioptric<T, Profile, Lens>& model
                                      const ProjectionCache* cache, SolvedReflection* solved) {
   constexpr bool kJet = !std::is_same_v<T, double>;
   constexpr bool kOrtho = Lens<T>::kIsOrthographic;
+  const bool reuse = solved != nullptr && solved->reuse && solved->has_q;
+  if (solved != nullptr && !reuse) *solved = SolvedReflection{};  // filled again only by a solve that succeeds
   const Eigen::Vector3d point_d = ToDouble(point_in_camera);
   if (!AllFinite(point_d.x(), point_d.y(), point_d.z()) || point_d.cwiseAbs().maxCoeff() > kMaxCoordinateMm)
     return ProjectionStatus::kInvalidInput;
@@ -357,8 +359,6 @@ ProjectionStatus ReflectionPointImpl(const Catadioptric<T, Profile, Lens>& model
                                         : Eigen::Vector3d(-(rotation_d.transpose() * translation_d));
   Eigen::Vector2d q;
   Eigen::Matrix2d jacobian;
-  const bool reuse = solved != nullptr && solved->reuse && solved->has_q;
-  if (solved != nullptr && !reuse) *solved = SolvedReflection{};  // a failed solve leaves nothing to reuse
   if (reuse) {
     q = solved->q_mm;
   } else if (axial) {

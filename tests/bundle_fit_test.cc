@@ -15,6 +15,7 @@
 #include "calib/initial_sensor.h"
 #include "calib/knot_choice.h"
 #include "calib/predicted_error.h"
+#include "calib/parallel_evaluation.h"
 #include "calib/projection_diff.h"
 #include "calib/reprojection_cost.h"
 #include "calib/sensor_blocks.h"
@@ -345,6 +346,46 @@ TEST(BundleFit, ThreadCountChangesNoDigit) {
   }
   for (size_t v = 0; v < one.poses.size(); ++v)
     EXPECT_EQ(one.poses[v].camera_from_target_translation_mm, three.poses[v].camera_from_target_translation_mm) << v;
+}
+
+// The parallel evaluation's cache (calib/parallel_evaluation.h) answers only what it
+// computed, at the values it computed it: a block made variable after the cache was
+// filled without its Jacobian, or parameters moved without a new preparation, send the
+// cost back to evaluating itself (r = x y + 2 y: dr/dx = y, dr/dy = x + 2).
+struct Product {
+  template <typename T>
+  bool operator()(const T* x, const T* y, T* residual) const {
+    residual[0] = x[0] * y[0] + 2.0 * y[0];
+    return true;
+  }
+};
+
+TEST(ParallelEvaluation, TheCacheNeverAnswersWhatItDidNotCompute) {
+  ParallelEvaluation evaluation(2);  // before the problem, which owns the cost
+  ceres::Problem::Options problem_options;
+  problem_options.evaluation_callback = &evaluation;
+  ceres::Problem problem(problem_options);
+  double x = 1.5, y = 0.5;
+  ceres::CostFunction* cost =
+      evaluation.Wrap(new ceres::AutoDiffCostFunction<Product, 1, 1, 1>(new Product), std::vector<double*>{&x, &y});
+  problem.AddResidualBlock(cost, nullptr, &x, &y);
+  problem.SetParameterBlockConstant(&y);
+  evaluation.UpdateConstantBlocks(problem);
+  evaluation.PrepareForEvaluation(true, true);  // the cache: r and dr/dx only
+  problem.SetParameterBlockVariable(&y);
+  evaluation.UpdateConstantBlocks(problem);
+  double residual = NAN, dx = NAN, dy = NAN;
+  double* jacobians[2] = {&dx, &dy};
+  const double* parameters[2] = {&x, &y};
+  ASSERT_TRUE(cost->Evaluate(parameters, &residual, jacobians));
+  EXPECT_EQ(residual, 1.75);
+  EXPECT_EQ(dx, 0.5);
+  EXPECT_EQ(dy, 3.5);
+  evaluation.PrepareForEvaluation(true, true);  // now both blocks
+  x = 2.0;  // moved without a new preparation
+  ASSERT_TRUE(cost->Evaluate(parameters, &residual, jacobians));
+  EXPECT_EQ(residual, 2.0);
+  EXPECT_EQ(dy, 4.0);
 }
 
 // The cost keeps the last reflection point to skip the solve in the Jet passes that share
