@@ -42,7 +42,8 @@ class ReprojectionCost {
         point_in_target_mm_(point_in_target_mm),
         observed_px_(observed_px),
         warp_basis_(warp_basis),
-        block_sizes_(BlockSizes(base, warp_basis.has_value())) {
+        block_sizes_(BlockSizes(base, warp_basis.has_value())),
+        last_scalars_(std::accumulate(block_sizes_.begin(), block_sizes_.end(), size_t{0})) {
     // The corner was detected, so its reflection lies on the mirror; iterates may stray a
     // little past the rim, where the profile is still defined.
     base_.rim_radius_mm = std::min(1.15 * base.rim_radius_mm, 0.99 * base.mirror.MaxRadiusMm());
@@ -104,8 +105,8 @@ class ReprojectionCost {
   template <typename T>
   bool SameScalarsAsLastCall(T const* const* p) const {
     size_t k = 0;
-    bool same = !last_scalars_.empty();
-    last_scalars_.resize(std::accumulate(block_sizes_.begin(), block_sizes_.end(), size_t{0}));
+    bool same = called_before_;
+    called_before_ = true;
     for (size_t b = 0; b < block_sizes_.size(); ++b)
       for (int i = 0; i < block_sizes_[b]; ++i, ++k) {
         const double value = ScalarPart(p[b][i]);
@@ -126,6 +127,7 @@ class ReprojectionCost {
   // at the same point, solve once. Mutable state in a cost is safe: each corner has its own
   // cost, evaluated by one thread at a time (Ceres, calib/parallel_evaluation.h).
   mutable std::vector<double> last_scalars_;
+  mutable bool called_before_ = false;
   mutable SolvedReflection solved_;
 };
 

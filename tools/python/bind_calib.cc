@@ -688,7 +688,8 @@ design tolerances, as --sensor); without one the fit starts from the mirror's ri
 lens_scale, principal_point, distortion, m, tilt, decenter, shape, poses; a list or 'a,b').
 loss_px: Huber scale (0: least squares). detection_passes: 2 re-detects through the
 first fit. threads: detection, board checks and the fit's Jacobians, 0 for all cores
-(the same result for any count). leave_one_out: also fit without each view. tolerances: design tolerances (dict name -> one std, or 'name=value,...').
+(the same result for any count). leave_one_out: also fit without each view.
+tolerances: design tolerances (dict name -> one std, or 'name=value,...').
 distances_mm / distances_n: where to predict the projection error (mm, or rim radii);
 max_predicted_error_px: warn above it. holdout: K views (spread evenly) kept out of the
 fit and evaluated with the sensor held (result.holdout). cross_validate: each half of the
