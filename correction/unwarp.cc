@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "correction/bilinear_remap.h"
 #include "correction/maps_json.h"
 #include "model/io/atomic_write.h"
 #include "model/first_error.h"
@@ -60,9 +61,10 @@ cv::Mat Unwarper::Apply(const cv::Mat& frame, const std::string& source) const {
   cv::Mat out;
   if (interpolation_ == Interpolation::kNearest)
     cv::remap(frame, out, map_x_, map_y_, cv::INTER_NEAREST, cv::BORDER_CONSTANT);
+  else if (interpolation_ == Interpolation::kLinear)
+    RemapLinear(frame, map1_, map2_, &out);
   else
-    cv::remap(frame, out, map1_, map2_, interpolation_ == Interpolation::kCubic ? cv::INTER_CUBIC : cv::INTER_LINEAR,
-              cv::BORDER_CONSTANT);
+    cv::remap(frame, out, map1_, map2_, cv::INTER_CUBIC, cv::BORDER_CONSTANT);
   return out;
 }
 

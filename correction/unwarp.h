@@ -1,6 +1,7 @@
 // Unwarping: omni images or video frames through a remap table to the virtual screen,
-// with cv::remap (fixed-point maps for linear and cubic: its fast path; the float maps
-// for nearest, which the fixed-point pair would round differently). The table comes from
+// through OpenCV's fixed-point maps for linear (RemapLinear: cv::remap's bytes, faster
+// for 8-bit colour frames) and cubic (cv::remap), the float maps for nearest, which the
+// fixed-point pair would round differently. The table comes from
 // a directory written by `remap` or is made on the spot from a view request. Frames are
 // read and written by the caller (video I/O stays at the front end); this file holds the
 // checks, the frame loop and the image encoding.
