@@ -20,7 +20,7 @@ namespace {
 // since the products are multiples of 1/1024), so (sum + 2^14) >> 15 over them equals
 // (sum + 2^9) >> 10 over the products in 1/1024. The one exception, fraction (0, 0),
 // where OpenCV stores 32767 and 1 instead of 32768 and 0, rounds to the same byte too.
-// tests/unwarp_test.cc checks every fraction against cv::remap.
+// tests/bilinear_remap_test.cc checks every fraction against cv::remap.
 constexpr int kFractionSteps = 32;
 constexpr int kWeightShift = 10;
 
@@ -155,7 +155,8 @@ bool CpuHasAvx2() {
 
 bool RemapLinearHasFastPath(const cv::Mat& frame, const cv::Mat& map1, const cv::Mat& map2) {
 #ifdef OMNICAL_REMAP_AVX2
-  return CpuHasAvx2() && frame.type() == CV_8UC3 && !frame.empty() && frame.step[0] <= 32767 &&
+  return CpuHasAvx2() && frame.dims == 2 && map1.dims == 2 && map2.dims == 2 && frame.type() == CV_8UC3 &&
+         !frame.empty() && frame.step[0] <= 32767 &&
          frame.rows <= 32767 && frame.cols <= 32767 && map1.type() == CV_16SC2 && map2.type() == CV_16UC1 &&
          map1.size() == map2.size() && !map1.empty();
 #else

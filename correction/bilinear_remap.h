@@ -1,6 +1,6 @@
 // Bilinear remap of 8-bit 3-channel frames through OpenCV's fixed-point maps: the same
-// bytes as cv::remap(frame, out, map1, map2, INTER_LINEAR, BORDER_CONSTANT, 0), about
-// twice as fast on one thread (docs/remap-speed.md). cv::remap spends most of its time
+// bytes as cv::remap(frame, out, map1, map2, INTER_LINEAR, BORDER_CONSTANT, 0), 1.7x as
+// fast on one thread (docs/remap-speed.md). cv::remap spends most of its time
 // per pixel on table look-ups and narrow loads; this kernel takes eight pixels at a time
 // with AVX2, where the CPU has it. Everything it does not handle goes to cv::remap.
 #pragma once

@@ -6,6 +6,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include <cstdint>
+#include <vector>
+
 namespace omnical {
 namespace {
 
@@ -67,6 +70,48 @@ TEST(RemapLinear, EveryFractionAndEveryBorderCaseGivesCvRemapsBytes) {
   }
 }
 
+TEST(RemapLinear, HighFractionBitsFarCoordinatesAndCutOutMapsAsCvRemap) {
+  const cv::Mat frame = Frame({37, 13}, 17);
+  // Maps cut from larger ones (rows not contiguous); fraction words over the whole 16-bit
+  // range (OpenCV uses the low 10 bits); coordinates out to the int16 limits.
+  cv::Mat larger1(40, 1100, CV_16SC2), larger2(40, 1100, CV_16UC1);
+  cv::Mat map1 = larger1(cv::Rect(30, 5, 1029, 16)), map2 = larger2(cv::Rect(30, 5, 1029, 16));
+  MakeMaps(frame.size(), &map1, &map2);
+  ASSERT_FALSE(map1.isContinuous());
+  cv::RNG rng(23);
+  for (int v = 0; v < map1.rows; ++v) {
+    for (int u = 0; u < map1.cols; ++u) {
+      map2.at<uint16_t>(v, u) = static_cast<uint16_t>(map2.at<uint16_t>(v, u) + 1024 * rng.uniform(0, 64));
+      if (v % 4 == 3 && u % 7 == 0) {
+        cv::Vec2s& xy = map1.at<cv::Vec2s>(v, u);
+        xy[u % 2] = static_cast<short>(u % 3 == 0 ? -32768 : 32767);
+      }
+    }
+  }
+  cv::Mat out;
+  RemapLinear(frame, map1, map2, &out);
+  EXPECT_EQ(DifferingBytes(out, OpenCvRemap(frame, map1, map2)), 0);
+}
+
+TEST(RemapLinear, ReadsNoByteBeyondAnExactlySizedFrame) {
+  // The frame is the whole of its allocation, so under AddressSanitizer (the CI's second
+  // pass) a read past its last byte stops the test. The taps sit at the last pixels the
+  // eight-byte reads may start from (row 0), and just past them (rows 1-3), eight alike
+  // in a row so that a looser bound would take them all at once.
+  const cv::Size size(21, 6);
+  std::vector<uint8_t> pixels(static_cast<size_t>(size.area()) * 3);
+  const cv::Mat frame(size, CV_8UC3, pixels.data());
+  Frame(size, 19).copyTo(frame);
+  cv::Mat map1(4, 64, CV_16SC2), map2(4, 64, CV_16UC1, cv::Scalar(1023));
+  for (int v = 0; v < map1.rows; ++v)
+    for (int u = 0; u < map1.cols; ++u)
+      map1.at<cv::Vec2s>(v, u) =
+          cv::Vec2s(static_cast<short>(size.width - 3 + v % 3), static_cast<short>(size.height - 2 + v / 3));
+  cv::Mat out;
+  RemapLinear(frame, map1, map2, &out);
+  EXPECT_EQ(DifferingBytes(out, OpenCvRemap(frame, map1, map2)), 0);
+}
+
 TEST(RemapLinear, AFrameCutFromALargerImageReadsNothingBeyondItsEdges) {
   // White all round: a tap read past the cut would show as a bright pixel.
   cv::Mat larger(30, 50, CV_8UC3, cv::Scalar(255, 255, 255));
@@ -108,6 +153,10 @@ TEST(RemapLinear, OtherFrameTypesGoToCvRemap) {
     RemapLinear(frame, map1, map2, &out);
     EXPECT_EQ(DifferingBytes(out, OpenCvRemap(frame, map1, map2)), 0) << type;
   }
+  // Not an image: a 3-D array of pixels.
+  const int sizes[3] = {4, 17, 29};
+  cv::Mat volume(3, sizes, CV_8UC3, cv::Scalar(100, 100, 100));
+  EXPECT_FALSE(RemapLinearHasFastPath(volume, map1, map2));
   // Rows over 32767 bytes: the kernel's 16-bit offset arithmetic would overflow.
   const cv::Mat wide = Frame({11000, 3}, 13);
   cv::Mat out;
