@@ -786,4 +786,13 @@ FitResult FitSensor(const Sensor& guess, const CalibrationTarget& target, const 
                     guess.model());
 }
 
+ceres::CostFunction* CreateReprojectionCost(const SensorModel& model, const Eigen::Vector3d& point_in_target_mm,
+                                            const Eigen::Vector2d& observed_px) {
+  return std::visit(
+      [&](const auto& m) -> ceres::CostFunction* {
+        return ReprojectionCostOf<std::decay_t<decltype(m)>>::type::Create(m, point_in_target_mm, observed_px);
+      },
+      model);
+}
+
 }  // namespace omnical

@@ -40,6 +40,10 @@
 #include "model/progress.h"
 #include "model/sensor.h"
 
+namespace ceres {
+class CostFunction;
+}
+
 namespace omnical {
 
 struct TargetPose {
@@ -123,5 +127,11 @@ bool InitialTargetPose(const Sensor& sensor, const CalibrationTarget& target, co
 // Fits from `guess` and the initial poses (one per detections.images entry).
 FitResult FitSensor(const Sensor& guess, const CalibrationTarget& target, const DetectionSet& detections,
                     const std::vector<TargetPose>& initial_poses, const FitOptions& options);
+
+// The fit's cost of one corner (calib/reprojection_cost.h) for the model's type, without
+// the warp block; the caller owns it. Its automatic derivatives are compiled here, once,
+// instead of again in each caller (they took a test ~30 s to compile).
+ceres::CostFunction* CreateReprojectionCost(const SensorModel& model, const Eigen::Vector3d& point_in_target_mm,
+                                            const Eigen::Vector2d& observed_px);
 
 }  // namespace omnical

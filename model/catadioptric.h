@@ -229,6 +229,11 @@ ProjectionStatus SolveFermatPoint(const Eigen::Vector3d& lens, const Profile& mi
   };
   Eigen::Vector2d q = seed_radius / rho * point.head<2>();
   FermatReflection e = evaluate(q);
+  // Iterations in a row that ended outside the mirror with their full step cut short at
+  // max_radius: the root lies beyond the mirror, and the iterates would only creep towards
+  // that wall for the remaining iterations, halving each step (most of a detection's time
+  // through a tilted tabulated mirror went into such points at the edges of its views).
+  int pressed_to_wall = 0;
   for (int iteration = 0; iteration < 100; ++iteration) {
     Eigen::Vector2d step;
     if (!FermatNewtonStep(e, &step.x(), &step.y())) {
@@ -247,6 +252,7 @@ ProjectionStatus SolveFermatPoint(const Eigen::Vector3d& lens, const Profile& mi
       return ProjectionStatus::kOk;
     }
     double alpha = 1.0;
+    bool cut_at_wall = false;
     for (int halving = 0;; ++halving) {
       const Eigen::Vector2d trial = q + alpha * step;
       if (trial.norm() < max_radius) {
@@ -258,9 +264,13 @@ ProjectionStatus SolveFermatPoint(const Eigen::Vector3d& lens, const Profile& mi
         }
       } else if (halving >= 30) {
         return ProjectionStatus::kOutsideMirror;
+      } else {
+        cut_at_wall = true;
       }
       alpha *= 0.5;
     }
+    pressed_to_wall = cut_at_wall && q.norm() > rim_mm * kRimSlack ? pressed_to_wall + 1 : 0;
+    if (pressed_to_wall >= 3) return ProjectionStatus::kOutsideMirror;
   }
   return ProjectionStatus::kNoSolution;
 }

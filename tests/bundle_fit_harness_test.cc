@@ -1,7 +1,8 @@
 // The bundle fit the Ceres way, over every registered lens x profile (the test sensors of
 // tests/test_sensors.h: aligned, and tilted 2 deg + decentred 1 mm with distortion):
-//  - ceres::GradientChecker on the reprojection cost (calib/reprojection_cost.h): the Jet
-//    derivatives through the implicit reflection solve agree with central differences;
+//  - ceres::GradientChecker on the reprojection cost (calib/reprojection_cost.h, made by
+//    CreateReprojectionCost in calib/bundle_fit.h): the Jet derivatives through the
+//    implicit reflection solve agree with central differences;
 //  - exact observations from a perturbed start recover the truth to 1e-6 relative, with
 //    the residual and parameter-block counts expected after gauge fixing;
 //  - the reported covariance against a Monte Carlo over noisy observations.
@@ -16,7 +17,6 @@
 #include <random>
 
 #include "calib/bundle_fit.h"
-#include "calib/reprojection_cost.h"
 #include "calib/sensor_blocks.h"
 #include "calib/synthetic/renderer.h"
 #include "calib/synthetic/scene.h"
@@ -92,7 +92,6 @@ TEST_P(EveryModel, ReprojectionCostPassesTheGradientChecker) {
   std::visit(
       [&](const auto& model) {
         using Model = std::decay_t<decltype(model)>;
-        using Cost = typename ReprojectionCostOf<Model>::type;
         int probes = 0;
         double worst = 0.0;
         // Mid-field, inner and outer (the rim images ~480 px from the centre).
@@ -101,12 +100,12 @@ TEST_P(EveryModel, ReprojectionCostPassesTheGradientChecker) {
           for (double distance_mm : {1.0 * kRimMm, 8.0 * kRimMm}) {
             const Corner corner = CornerSeenAt(sensor, pixel, distance_mm);
             const std::unique_ptr<ceres::CostFunction> cost(
-                Cost::Create(model, corner.point_in_target_mm, pixel + Eigen::Vector2d(0.3, -0.2)));
+                CreateReprojectionCost(sensor.model(), corner.point_in_target_mm, pixel + Eigen::Vector2d(0.3, -0.2)));
             SensorBlocks<Model> blocks(model);
             std::vector<double*> parameters = blocks.Pointers();
             // The shape block in normalised units, the others as they are.
             std::vector<std::vector<double>> scales;
-            for (int size : Cost::BlockSizes(model)) scales.emplace_back(size, 1.0);
+            for (int size : cost->parameter_block_sizes()) scales.emplace_back(size, 1.0);
             if (!blocks.shape.empty())
               ForEachProfileParameter<typename Model::ProfileType>(
                   model.mirror.NumParams(), [&](const ParameterField& field, int k, int index) {

@@ -4,6 +4,9 @@
 // RMS < 1e-6 px. This isolates the optimiser (and the Jet derivatives it runs on).
 #include <gtest/gtest.h>
 
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/problem.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -17,7 +20,6 @@
 #include "calib/predicted_error.h"
 #include "calib/parallel_evaluation.h"
 #include "calib/projection_diff.h"
-#include "calib/reprojection_cost.h"
 #include "calib/sensor_blocks.h"
 #include "calib/synthetic/renderer.h"
 #include "test_sensors.h"
@@ -407,12 +409,13 @@ TEST(ReprojectionCost, AnswersAsAFreshCostWhateverItEvaluatedBefore) {
   std::vector<double*> parameters = blocks.Pointers();
   parameters.push_back(rotation.data());
   parameters.push_back(translation.data());
-  const std::vector<int> sizes = ReprojectionCost<SphereProfile, PinholeLens>::BlockSizes(model);
-  ASSERT_EQ(sizes.size(), parameters.size());
   const auto found = std::find_if(truth.target.corners().begin(), truth.target.corners().end(),
                                   [&](const TargetCorner& c) { return c.id == image.corners[5].id; });
   ASSERT_NE(found, truth.target.corners().end());
   const Eigen::Vector3d corner = found->point_in_target;
+  const std::unique_ptr<ceres::CostFunction> fresh(CreateReprojectionCost(model, corner, image.corners[5].pixel));
+  const std::vector<int32_t> sizes = fresh->parameter_block_sizes();
+  ASSERT_EQ(sizes.size(), parameters.size());
   struct Answer {
     std::array<double, 2> residual;
     std::vector<std::vector<double>> jacobians;
@@ -425,16 +428,14 @@ TEST(ReprojectionCost, AnswersAsAFreshCostWhateverItEvaluatedBefore) {
     EXPECT_TRUE(cost.Evaluate(parameters.data(), answer.residual.data(), with_jacobians ? jacobians.data() : nullptr));
     return answer;
   };
-  const std::unique_ptr<ceres::CostFunction> fresh(
-      ReprojectionCost<SphereProfile, PinholeLens>::Create(model, corner, image.corners[5].pixel));
   const Answer expected = evaluate(*fresh, true);
   // A plain residual takes the double root itself, a Jacobian one more Newton step in Jets:
   // the two agree to rounding only, so each is compared with its own kind.
   const std::unique_ptr<ceres::CostFunction> fresh_plain(
-      ReprojectionCost<SphereProfile, PinholeLens>::Create(model, corner, image.corners[5].pixel));
+      CreateReprojectionCost(model, corner, image.corners[5].pixel));
   const Answer expected_plain = evaluate(*fresh_plain, false);
   const std::unique_ptr<ceres::CostFunction> used(
-      ReprojectionCost<SphereProfile, PinholeLens>::Create(model, corner, image.corners[5].pixel));
+      CreateReprojectionCost(model, corner, image.corners[5].pixel));
   // Elsewhere first (another m and tilt), then a plain residual, then twice the Jacobian.
   const double m = parameters[1][0], tilt = parameters[2][0];
   parameters[1][0] += 0.7, parameters[2][0] += 0.01;

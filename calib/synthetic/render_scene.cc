@@ -53,7 +53,9 @@ void WriteRenderedScene(const Scene& scene, const std::string& scene_path, const
     if (scene.formation.jpeg_quality > 0) {
       cv::imencode(".jpg", views[k].image, pngs[k], {cv::IMWRITE_JPEG_QUALITY, scene.formation.jpeg_quality});
     } else {
-      cv::imencode(".png", views[k].image, pngs[k], {cv::IMWRITE_PNG_COMPRESSION, 9});
+      // zlib's default level: 5 % larger files than level 9 for a ninth of the time (0.05
+      // against 0.43 s a 1000 x 1000 frame, which was a fifth of a render's CPU).
+      cv::imencode(".png", views[k].image, pngs[k], {cv::IMWRITE_PNG_COMPRESSION, 6});
     }
     truths[k] = GroundTruthJsonText(view, views[k].truth, dir_name, sensor_yaml, sensor, image_name);
     index["views"].push_back({{"name", view.name}, {"image", image_name}, {"truth", view.name + ".json"}});
