@@ -229,8 +229,8 @@ ProjectionStatus SolveFermatPoint(const Eigen::Vector3d& lens, const Profile& mi
   };
   Eigen::Vector2d q = seed_radius / rho * point.head<2>();
   FermatReflection e = evaluate(q);
-  // Iterations in a row that ended outside the mirror with their full step cut short at
-  // max_radius: the root lies beyond the mirror, and the iterates would only creep towards
+  // Iterations in a row that moved outwards and ended outside the mirror with their full
+  // step cut short at max_radius: the root lies beyond the mirror, and the iterates would only creep towards
   // that wall for the remaining iterations, halving each step (most of a detection's time
   // through a tilted tabulated mirror went into such points at the edges of its views).
   int pressed_to_wall = 0;
@@ -251,6 +251,7 @@ ProjectionStatus SolveFermatPoint(const Eigen::Vector3d& lens, const Profile& mi
       if (q_out->norm() > rim_mm * kRimSlack) return ProjectionStatus::kOutsideMirror;
       return ProjectionStatus::kOk;
     }
+    const double radius_before = q.norm();
     double alpha = 1.0;
     bool cut_at_wall = false;
     for (int halving = 0;; ++halving) {
@@ -269,7 +270,11 @@ ProjectionStatus SolveFermatPoint(const Eigen::Vector3d& lens, const Profile& mi
       }
       alpha *= 0.5;
     }
-    pressed_to_wall = cut_at_wall && q.norm() > rim_mm * kRimSlack ? pressed_to_wall + 1 : 0;
+    // Only outward moves count: a near-singular step may cross the disc and cut the far
+    // wall on its way back inside.
+    const double radius_after = q.norm();
+    pressed_to_wall =
+        cut_at_wall && radius_after > radius_before && radius_after > rim_mm * kRimSlack ? pressed_to_wall + 1 : 0;
     if (pressed_to_wall >= 3) return ProjectionStatus::kOutsideMirror;
   }
   return ProjectionStatus::kNoSolution;
