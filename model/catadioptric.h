@@ -230,9 +230,10 @@ ProjectionStatus SolveFermatPoint(const Eigen::Vector3d& lens, const Profile& mi
   Eigen::Vector2d q = seed_radius / rho * point.head<2>();
   FermatReflection e = evaluate(q);
   // Iterations in a row that moved outwards and ended outside the mirror with their full
-  // step cut short at max_radius: the root lies beyond the mirror, and the iterates would only creep towards
-  // that wall for the remaining iterations, halving each step (most of a detection's time
-  // through a tilted tabulated mirror went into such points at the edges of its views).
+  // step cut short at max_radius: the root lies beyond the mirror, and the iterates would
+  // only creep towards that wall for the remaining iterations, halving each step (most of
+  // a detection's time through a tilted tabulated mirror went into such points at the
+  // edges of its views).
   int pressed_to_wall = 0;
   for (int iteration = 0; iteration < 100; ++iteration) {
     Eigen::Vector2d step;
