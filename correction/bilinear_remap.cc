@@ -15,6 +15,9 @@ namespace omnical {
 
 namespace {
 
+// Everything here serves the AVX2 path; elsewhere RemapLinear is cv::remap (and unused
+// helpers would stop a -Werror build).
+#ifdef OMNICAL_REMAP_AVX2
 // OpenCV's fixed-point maps hold fractions in 1/32 px (INTER_TAB_SIZE). Its bilinear
 // weights are the products of two such fractions in 1/32768 (each an exact multiple of 32,
 // since the products are multiples of 1/1024), so (sum + 2^14) >> 15 over them equals
@@ -54,13 +57,13 @@ struct RowInput {
   int width;
 };
 
-void RemapRowAnywhere(const RowInput& in, int from, uint8_t* out) {
-  for (int u = from; u < in.width; ++u)
+// Pixels [from, to) of the row one by one.
+void RemapPixelsAnywhere(const RowInput& in, int from, int to, uint8_t* out) {
+  for (int u = from; u < to; ++u)
     RemapPixel(in.frame, in.step, in.cols, in.rows, in.source_xy[2 * u], in.source_xy[2 * u + 1], in.fraction[u],
                out + 3 * u);
 }
 
-#ifdef OMNICAL_REMAP_AVX2
 // Four pixels whose two taps rows each have 8 readable bytes at the top-left tap:
 // `top`/`bottom` hold those 8 bytes per 64-bit lane, `fractions` fx in byte 0 and fy in
 // byte 1 of each lane. Returns the pixels as 16-bit [R G B 0] x 4, ordered [0 1 | 2 3].
@@ -121,9 +124,7 @@ __attribute__((target("avx2"))) void RemapRowAvx2(const RowInput& in, uint8_t* o
     const __m256i xy = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in.source_xy + 2 * u));
     const __m256i inside = _mm256_and_si256(_mm256_cmpgt_epi16(fast_limit, xy), _mm256_cmpgt_epi16(xy, minus_one));
     if (_mm256_movemask_epi8(inside) != -1) {
-      for (int k = u; k < u + 8; ++k)
-        RemapPixel(in.frame, in.step, in.cols, in.rows, in.source_xy[2 * k], in.source_xy[2 * k + 1], in.fraction[k],
-                   out + 3 * k);
+      RemapPixelsAnywhere(in, u, u + 8, out);
       continue;
     }
     alignas(32) int32_t offset[8];
@@ -142,7 +143,7 @@ __attribute__((target("avx2"))) void RemapRowAvx2(const RowInput& in, uint8_t* o
     _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 3 * u), _mm256_castsi256_si128(bytes));
     _mm_storel_epi64(reinterpret_cast<__m128i*>(out + 3 * u + 16), _mm256_extracti128_si256(bytes, 1));
   }
-  RemapRowAnywhere(in, u, out);
+  RemapPixelsAnywhere(in, u, in.width, out);
 }
 
 bool CpuHasAvx2() {
