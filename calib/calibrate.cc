@@ -6,6 +6,9 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <numeric>
+#include <optional>
+#include <utility>
 
 #include "calib/board_scale.h"
 #include "calib/cross_validation.h"
@@ -401,13 +404,44 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     // Without a spline: the guess's family, or the polynomial the rim circle starts from.
     const std::string guess_profile = input.guess ? input.guess->profile_name() : "";
     const std::string base = guess_profile.empty() || guess_profile == "spline" ? "polynomial" : guess_profile;
-    record.knot_choice = ChooseKnots(fit_start, base, input.target, kept, kept_poses, fit_options, options.progress);
-    const int chosen = record.knot_choice->chosen;
-    fit_start = chosen > 0 ? ConvertProfile(fit_start, "spline", chosen) : ConvertProfile(fit_start, base);
+    KnotChoice& choice = *(record.knot_choice =
+                               ChooseKnots(fit_start, base, input.target, kept, kept_poses, fit_options, options.progress));
+    // The folds score how well a count predicts; the full fit with it may still bend the
+    // mirror more than a mirror can (z'' <= 0 where few corners reach, by the rim), and
+    // its sensor.yaml would not load. Then the next count by held-out RMS whose full fit
+    // is a valid mirror (none valid: the chosen one, with the validation warning below).
+    std::vector<size_t> order(choice.candidates.size());
+    std::iota(order.begin(), order.end(), size_t{0});
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      const bool a_chosen = choice.candidates[a] == choice.chosen, b_chosen = choice.candidates[b] == choice.chosen;
+      if (a_chosen != b_chosen) return a_chosen;
+      const double ra = choice.held_out_rms_px[a], rb = choice.held_out_rms_px[b];
+      return std::isfinite(ra) && (!std::isfinite(rb) || ra < rb);
+    });
+    const Sensor converted_from = fit_start;
+    std::optional<std::pair<FitResult, Sensor>> first;
+    std::vector<int> invalid;
+    for (size_t k : order) {
+      if (!std::isfinite(choice.held_out_rms_px[k])) break;
+      const int knots = choice.candidates[k];
+      const Sensor start = knots > 0 ? ConvertProfile(converted_from, "spline", knots) : ConvertProfile(converted_from, base);
+      FitResult candidate_fit = FitSensor(start, input.target, views.detections, views.poses, WithShapeOf(fit_options, start));
+      if (candidate_fit.sensor && ValidateSensorModel(candidate_fit.sensor->model()).empty()) {
+        choice.chosen = knots;
+        fit = std::move(candidate_fit), fit_start = start;
+        first.reset();
+        break;
+      }
+      invalid.push_back(knots);
+      if (!first) first.emplace(std::move(candidate_fit), start);
+    }
+    if (first) fit = std::move(first->first), fit_start = first->second, invalid.clear();
+    fit_options = WithShapeOf(fit_options, fit_start);
+    const int chosen = choice.chosen;
     record.start += chosen > 0 ? ", " + std::to_string(chosen) + " knots (chosen by held-out folds)"
                                : "; held-out folds chose the " + base + " mirror over a spline";
-    fit_options = WithShapeOf(fit_options, fit_start);
-    fit = FitSensor(fit_start, input.target, views.detections, views.poses, fit_options);
+    for (int knots : invalid)
+      record.start += "; " + (knots > 0 ? std::to_string(knots) + " knots" : base) + " fitted the full set to no valid mirror";
   }
   const DetectionSet& usable = views.detections;
   if (!fit.sensor) throw InputError(InputMessage(input.source, "", "the fit failed: " + fit.solver_report));

@@ -4,10 +4,13 @@
 #include <cmath>
 #include <exception>
 #include <map>
+#include <vector>
 
 #include "calib/cross_validation.h"
 #include "calib/initial_sensor.h"
 #include "model/input_error.h"
+#include "model/parallel_rows.h"
+#include "model/progress.h"
 
 namespace omnical {
 
@@ -53,41 +56,62 @@ KnotChoice ChooseKnots(const Sensor& start, const std::string& base_profile, con
   choice.folds = std::min(5, count);
   options.compute_covariance = false;
   options.progress = nullptr;
-  ProgressReporter reporter(progress, "knots", static_cast<int>(choice.candidates.size()) * choice.folds);
-  for (int knots : choice.candidates) {
-    const Sensor candidate = knots > 0 ? ConvertProfile(start, "spline", knots) : ConvertProfile(start, base_profile);
+  const int folds = choice.folds, jobs = static_cast<int>(choice.candidates.size()) * folds;
+  ProgressReporter reporter(progress, "knots", jobs);
+  std::vector<Sensor> candidates;
+  for (int knots : choice.candidates)
+    candidates.push_back(knots > 0 ? ConvertProfile(start, "spline", knots) : ConvertProfile(start, base_profile));
+  // Every (count, fold) fit is independent: they share the threads, one fit each (a fit's
+  // result is the same for any thread count, so the choice is too).
+  struct FoldScore {
+    bool failed = false;
     double square = 0.0;
     int corners = 0;
-    bool failed = false;
-    for (int fold = 0; fold < choice.folds && !failed; ++fold) {
-      DetectionSet training = views, held = views;
-      training.images.clear(), held.images.clear();
-      std::vector<TargetPose> poses;
-      for (int v = 0; v < count; ++v) {
-        if (v % choice.folds == fold) {
-          held.images.push_back(views.images[v]);
-        } else {
-          training.images.push_back(views.images[v]);
-          poses.push_back(initial_poses[v]);
-        }
+  };
+  std::vector<FoldScore> scores(jobs);
+  const int workers = std::max(1, options.threads);
+  options.threads = 1;
+  ParallelRows(jobs, workers, [&](int job) {
+    if (reporter.cancelled()) return;
+    const Sensor& candidate = candidates[job / folds];
+    const int fold = job % folds;
+    DetectionSet training = views, held = views;
+    training.images.clear(), held.images.clear();
+    std::vector<TargetPose> poses;
+    for (int v = 0; v < count; ++v) {
+      if (v % folds == fold) {
+        held.images.push_back(views.images[v]);
+      } else {
+        training.images.push_back(views.images[v]);
+        poses.push_back(initial_poses[v]);
       }
-      const FitResult fit = FitSensor(candidate, target, training, poses, WithShapeOf(options, candidate));
-      reporter.Step();
-      if (!fit.sensor) {
-        failed = true;
-        continue;
-      }
+    }
+    FoldScore& score = scores[job];
+    const FitResult fit = FitSensor(candidate, target, training, poses, WithShapeOf(options, candidate));
+    if (fit.sensor) {
       FitOptions held_options = WithShapeOf(options, candidate);
       if (fit.board_warp) held_options.board_warp = fit.board_warp->warp;
       const HeldOutViews result = EvaluateHeldOutViews(*fit.sensor, target, held, held_options);
       // A view whose pose cannot be fitted through this sensor counts against the count
       // as failing: its corners are not in the score, so a score without them would flatter.
-      if (!result.not_evaluated.empty() || !(result.corners > 0)) {
-        failed = true;
-        continue;
-      }
-      square += result.rms_px * result.rms_px * result.corners;
-      corners += result.corners;
+      score.failed = !result.not_evaluated.empty() || !(result.corners > 0);
+      score.square = result.rms_px * result.rms_px * result.corners;
+      score.corners = result.corners;
+    } else {
+      score.failed = true;
+    }
+    reporter.Advance();
+  });
+  reporter.ThrowIfCancelled();
+  for (size_t k = 0; k < choice.candidates.size(); ++k) {
+    double square = 0.0;
+    int corners = 0;
+    bool failed = false;
+    for (int fold = 0; fold < folds; ++fold) {
+      const FoldScore& score = scores[k * folds + fold];
+      failed |= score.failed;
+      square += score.square;
+      corners += score.corners;
     }
     choice.held_out_rms_px.push_back(failed ? NAN : std::sqrt(square / corners));
     if (!failed) choice.held_out_corners = corners;

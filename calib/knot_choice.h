@@ -49,7 +49,8 @@ FitOptions WithShapeOf(FitOptions options, const Sensor& candidate);
 // start: the starting sensor, any family (converted to each candidate by its sag);
 // base_profile: candidate 0's family (a family the fit can shape, not the spline);
 // views/initial_poses: the views to fit (>= 4) and their starting poses; options: the
-// full fit's (no covariance is computed here). Throws InputError naming `knots` when
+// full fit's (no covariance is computed here); the candidates' fold fits share
+// options.threads, one fit per thread. Throws InputError naming `knots` when
 // there are too few views or no count could be fitted.
 KnotChoice ChooseKnots(const Sensor& start, const std::string& base_profile, const CalibrationTarget& target,
                        const DetectionSet& views,

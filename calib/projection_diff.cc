@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <variant>
+#include <vector>
 
 #include "calib/bundle_fit.h"
 #include "calib/predicted_error.h"
@@ -16,13 +18,28 @@ namespace {
 // Pixels of `points` moved by (angle-axis, translation), through `sensor`; false if any
 // does not project (a step that pushes a field point off the mirror is not taken).
 bool MovedPixels(const Sensor& sensor, const Eigen::Matrix3Xd& points, const double* angle_axis, const double* translation,
-                 Eigen::Matrix2Xd* pixels) {
+                 Eigen::Matrix2Xd* pixels, std::vector<ProjectionStatus>* statuses) {
   Eigen::Matrix3d rotation;
   ceres::AngleAxisToRotationMatrix(angle_axis, ceres::ColumnMajorAdapter3x3(rotation.data()));
   const Eigen::Matrix3Xd moved = (rotation * points).colwise() + Eigen::Vector3d(translation[0], translation[1], translation[2]);
+  sensor.ProjectBatch(moved, pixels, statuses);
+  return std::all_of(statuses->begin(), statuses->end(), [](ProjectionStatus s) { return s == ProjectionStatus::kOk; });
+}
+bool MovedPixels(const Sensor& sensor, const Eigen::Matrix3Xd& points, const double* angle_axis, const double* translation,
+                 Eigen::Matrix2Xd* pixels) {
   std::vector<ProjectionStatus> statuses;
-  sensor.ProjectBatch(moved, pixels, &statuses);
-  return std::all_of(statuses.begin(), statuses.end(), [](ProjectionStatus s) { return s == ProjectionStatus::kOk; });
+  return MovedPixels(sensor, points, angle_axis, translation, pixels, &statuses);
+}
+
+// The sensor with no camera body: the alignment needs where a point is seen, not whether
+// the body's reflection covers it.
+Sensor WithoutCameraBody(const Sensor& sensor) {
+  return std::visit(
+      [](auto model) {
+        model.camera_body_radius_mm = 0.0;
+        return Sensor(model);
+      },
+      sensor.model());
 }
 
 // All field points at once: one batch projection per evaluation, the 2N x 6 Jacobian by
@@ -52,13 +69,22 @@ class AlignmentCost : public ceres::CostFunction {
           for (int i = 0; i < 3; ++i) plus[b][i] = minus[b][i] = parameters[b][i];
         plus[block][k] += kStep[block];
         minus[block][k] -= kStep[block];
+        // Per point: central where both sides project, one-sided where one does, zero
+        // where neither (that point then steers no step). Failing the whole evaluation
+        // instead would end the solve at the first accepted point with a field point
+        // within a step of the rim, and leave the two calibrations unaligned.
         Eigen::Matrix2Xd up, down;
-        if (!MovedPixels(other_, points_, plus[0], plus[1], &up) || !MovedPixels(other_, points_, minus[0], minus[1], &down))
-          return false;
-        const Eigen::Matrix2Xd column = (up - down) / (2.0 * kStep[block]);
+        std::vector<ProjectionStatus> up_status, down_status;
+        MovedPixels(other_, points_, plus[0], plus[1], &up, &up_status);
+        MovedPixels(other_, points_, minus[0], minus[1], &down, &down_status);
         for (Eigen::Index p = 0; p < points_.cols(); ++p) {
-          jacobians[block][(2 * p) * 3 + k] = column(0, p);
-          jacobians[block][(2 * p + 1) * 3 + k] = column(1, p);
+          const bool has_up = up_status[p] == ProjectionStatus::kOk, has_down = down_status[p] == ProjectionStatus::kOk;
+          Eigen::Vector2d column = Eigen::Vector2d::Zero();
+          if (has_up && has_down) column = (up.col(p) - down.col(p)) / (2.0 * kStep[block]);
+          else if (has_up) column = (up.col(p) - pixels.col(p)) / kStep[block];
+          else if (has_down) column = (pixels.col(p) - down.col(p)) / kStep[block];
+          jacobians[block][(2 * p) * 3 + k] = column.x();
+          jacobians[block][(2 * p + 1) * 3 + k] = column.y();
         }
       }
     }
@@ -123,7 +149,8 @@ ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, 
   double angle_axis[3] = {0.0, 0.0, 0.0}, translation[3] = {0.0, 0.0, 0.0};
   // The alignment's steps (and its central differences) move points at the rim a little
   // past it: through a 15 % wider rim they still project (as the bundle fit's cost does).
-  const Sensor wide = SensorWithWiderRim(other, 1.15);
+  // Nor does the camera body hide any (a point moving into its shadow would stop a step).
+  const Sensor wide = WithoutCameraBody(SensorWithWiderRim(other, 1.15));
   Eigen::Matrix2Xd before;
   MovedPixels(wide, kept_points, angle_axis, translation, &before);
   diff.unaligned_rms_px = std::sqrt((before - kept_pixels).colwise().squaredNorm().mean());

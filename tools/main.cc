@@ -1,6 +1,7 @@
 // The omnical command line: one binary, one subcommand per job (tools/commands.h).
 // Exit codes: 0 success, 2 bad input or usage (one line on stderr), 1 internal error.
 #include <CLI/CLI.hpp>
+#include <glog/logging.h>
 #include <opencv2/core/utils/logger.hpp>
 
 #include <cmath>
@@ -35,6 +36,9 @@ std::vector<std::string> SplitOnCommas(const std::string& text) {
 int main(int argc, char** argv) {
   // Unreadable inputs get omnical's one-line errors; OpenCV's own warnings would add lines.
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);
+  // Ceres logs a solve it ends early ("Terminating: ...") at glog's ERROR level; omnical
+  // reports each failed fit or alignment in its own words, so only fatal ones may print.
+  FLAGS_minloglevel = google::GLOG_FATAL;
   using namespace omnical;
   // Ctrl-C: the outputs are renamed into place only when complete; this removes the one
   // being written, so an interrupted run leaves the previous results and nothing else.
