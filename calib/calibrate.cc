@@ -6,7 +6,6 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <numeric>
 #include <optional>
 #include <utility>
 
@@ -394,6 +393,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   }
   // The spline's knot count by held-out folds over the views the fit kept, then the fit
   // again with that count.
+  std::string knot_fallback;  // why the fitted count is not the folds' choice
   if (options.knots == kChooseKnots && fit.sensor) {
     DetectionSet kept = views.detections;
     kept.images.clear();
@@ -408,40 +408,50 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
                                ChooseKnots(fit_start, base, input.target, kept, kept_poses, fit_options, options.progress));
     // The folds score how well a count predicts; the full fit with it may still bend the
     // mirror more than a mirror can (z'' <= 0 where few corners reach, by the rim), and
-    // its sensor.yaml would not load. Then the next count by held-out RMS whose full fit
-    // is a valid mirror (none valid: the chosen one, with the validation warning below).
-    std::vector<size_t> order(choice.candidates.size());
-    std::iota(order.begin(), order.end(), size_t{0});
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-      const bool a_chosen = choice.candidates[a] == choice.chosen, b_chosen = choice.candidates[b] == choice.chosen;
-      if (a_chosen != b_chosen) return a_chosen;
-      const double ra = choice.held_out_rms_px[a], rb = choice.held_out_rms_px[b];
-      return std::isfinite(ra) && (!std::isfinite(rb) || ra < rb);
-    });
-    const Sensor converted_from = fit_start;
-    std::optional<std::pair<FitResult, Sensor>> first;
-    std::vector<int> invalid;
-    for (size_t k : order) {
-      if (!std::isfinite(choice.held_out_rms_px[k])) break;
+    // its sensor.yaml would not load. Then the same rule among the counts not yet tried,
+    // until a full fit is a valid mirror (none: the folds' choice, with the validation
+    // warning below).
+    const int folds_choice = choice.chosen;
+    std::vector<bool> tried(choice.candidates.size(), false);
+    std::optional<std::pair<FitResult, Sensor>> first_fitted;
+    int first_fitted_knots = folds_choice;
+    std::optional<FitResult> first_failed;  // its report, should no count fit at all
+    std::string rejected;
+    bool valid = false;
+    for (int k = PreferredKnotCount(choice, tried); k >= 0 && !valid; k = PreferredKnotCount(choice, tried)) {
+      tried[k] = true;
       const int knots = choice.candidates[k];
-      const Sensor start = knots > 0 ? ConvertProfile(converted_from, "spline", knots) : ConvertProfile(converted_from, base);
+      Sensor start = knots > 0 ? ConvertProfile(fit_start, "spline", knots) : ConvertProfile(fit_start, base);
       FitResult candidate_fit = FitSensor(start, input.target, views.detections, views.poses, WithShapeOf(fit_options, start));
+      const std::string name = knots > 0 ? std::to_string(knots) + " knots" : base;
       if (candidate_fit.sensor && ValidateSensorModel(candidate_fit.sensor->model()).empty()) {
+        valid = true;
         choice.chosen = knots;
-        fit = std::move(candidate_fit), fit_start = start;
-        first.reset();
-        break;
+        first_fitted.emplace(std::move(candidate_fit), std::move(start));
+      } else {
+        rejected += (rejected.empty() ? "" : ", ") + name + (candidate_fit.sensor ? " (no valid mirror)" : " (no fit)");
+        if (!first_fitted && candidate_fit.sensor) {
+          first_fitted.emplace(std::move(candidate_fit), std::move(start));
+          first_fitted_knots = knots;
+        } else if (!candidate_fit.sensor && !first_failed) {
+          first_failed = std::move(candidate_fit);
+        }
       }
-      invalid.push_back(knots);
-      if (!first) first.emplace(std::move(candidate_fit), start);
     }
-    if (first) fit = std::move(first->first), fit_start = first->second, invalid.clear();
+    if (first_fitted) {
+      fit = std::move(first_fitted->first), fit_start = std::move(first_fitted->second);
+      if (!valid) choice.chosen = first_fitted_knots;
+    } else if (first_failed) {
+      fit = std::move(*first_failed);  // no sensor: "the fit failed" below
+    }
     fit_options = WithShapeOf(fit_options, fit_start);
     const int chosen = choice.chosen;
-    record.start += chosen > 0 ? ", " + std::to_string(chosen) + " knots (chosen by held-out folds)"
-                               : "; held-out folds chose the " + base + " mirror over a spline";
-    for (int knots : invalid)
-      record.start += "; " + (knots > 0 ? std::to_string(knots) + " knots" : base) + " fitted the full set to no valid mirror";
+    record.start += chosen > 0 ? ", " + std::to_string(chosen) + " knots" : ", the " + base + " mirror";
+    record.start += chosen == folds_choice ? " (chosen by held-out folds)" : " (held-out folds' next choice)";
+    if (chosen != folds_choice)
+      knot_fallback = "the full set fitted with " + rejected + "; " +
+                      (chosen > 0 ? std::to_string(chosen) + " knots" : "the " + base + " mirror") +
+                      ", the folds' next choice, fitted instead" + (valid ? "" : " (no valid mirror either)");
   }
   const DetectionSet& usable = views.detections;
   if (!fit.sensor) throw InputError(InputMessage(input.source, "", "the fit failed: " + fit.solver_report));
@@ -463,6 +473,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   if (options.leave_one_out) record.leave_one_out = LeaveOneOut(fit_start, input, views, fit_options, options.progress);
   if (!why_invalid.empty())
     warnings.push_back({WarningCode::kSensorInvalid, "", "the fitted sensor fails validation: " + why_invalid});
+  if (!knot_fallback.empty()) warnings.push_back({WarningCode::kKnotCountReplaced, "knots", knot_fallback});
   if (!fit.converged) warnings.push_back({WarningCode::kNotConverged, "", "the solver did not converge: " + fit.solver_report});
   if (!fit.covariance_ok)
     warnings.push_back({WarningCode::kFreeGauge, "",

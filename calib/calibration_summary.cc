@@ -62,9 +62,11 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
   if (const auto& cross = record.cross_validation)
     AppendFormatted(out,
                     "two halves (RMS %.4f / %.4f px) differ at %.0f mm by %.4f px RMS, %.4f px max over %d field "
-                    "pixels (after the best rigid alignment: %.3f deg, %.2f mm)\n",
+                    "pixels (%s: %.3f deg, %.2f mm)\n",
                     cross->half_rms_px[0], cross->half_rms_px[1], cross->diff.distance_mm, cross->diff.rms_px,
-                    cross->diff.max_px, cross->diff.compared, cross->diff.rotation_deg,
+                    cross->diff.max_px, cross->diff.compared,
+                    cross->diff.aligned ? "after the best rigid alignment" : "alignment FAILED, unaligned",
+                    cross->diff.rotation_deg,
                     cross->diff.translation_mm.norm());
   return out;
 }

@@ -21,6 +21,7 @@ const char* WarningCodeName(WarningCode code) {
     case WarningCode::kPredictedErrorUnknown: return "predicted_error_unknown";
     case WarningCode::kPredictedErrorHigh: return "predicted_error_high";
     case WarningCode::kHeldOutWorse: return "held_out_worse";
+    case WarningCode::kKnotCountReplaced: return "knot_count_replaced";
   }
   return "unknown";
 }

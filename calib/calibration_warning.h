@@ -24,6 +24,7 @@ enum class WarningCode {
   kPredictedErrorUnknown,     // no field pixel projects at a distance
   kPredictedErrorHigh,        // the predicted projection error exceeds the threshold
   kHeldOutWorse,              // held-out views fit much worse than the training views
+  kKnotCountReplaced,         // subject: knots; the folds' count fitted no valid mirror, the next was used
 };
 
 // A stable lower-case name for programs (Python's CalibrationWarning.code), e.g.

@@ -40,6 +40,15 @@ FitOptions WithShapeOf(FitOptions options, const Sensor& candidate) {
   return options;
 }
 
+int PreferredKnotCount(const KnotChoice& choice, const std::vector<bool>& excluded) {
+  double best = HUGE_VAL;
+  for (size_t k = 0; k < choice.candidates.size(); ++k)
+    if (!excluded[k] && std::isfinite(choice.held_out_rms_px[k])) best = std::min(best, choice.held_out_rms_px[k]);
+  for (size_t k = 0; k < choice.candidates.size(); ++k)
+    if (!excluded[k] && choice.held_out_rms_px[k] <= best * (1.0 + kKnotScoreTolerance)) return static_cast<int>(k);
+  return -1;
+}
+
 KnotChoice ChooseKnots(const Sensor& start, const std::string& base_profile, const CalibrationTarget& target,
                        const DetectionSet& views,
                        const std::vector<TargetPose>& initial_poses, FitOptions options, const ProgressCallback& progress) {
@@ -71,7 +80,11 @@ KnotChoice ChooseKnots(const Sensor& start, const std::string& base_profile, con
   std::vector<FoldScore> scores(jobs);
   const int workers = std::max(1, options.threads);
   options.threads = 1;
-  ParallelRows(jobs, workers, [&](int job) {
+  // Callbacks a caller gave the solver would be called from several fits at once.
+  options.solver.callbacks.clear();
+  // The most knots (the slowest fits) first, so no long fit starts last.
+  ParallelRows(jobs, workers, [&](int reversed) {
+    const int job = jobs - 1 - reversed;
     if (reporter.cancelled()) return;
     const Sensor& candidate = candidates[job / folds];
     const int fold = job % folds;
@@ -116,15 +129,9 @@ KnotChoice ChooseKnots(const Sensor& start, const std::string& base_profile, con
     choice.held_out_rms_px.push_back(failed ? NAN : std::sqrt(square / corners));
     if (!failed) choice.held_out_corners = corners;
   }
-  double best = HUGE_VAL;
-  for (double rms : choice.held_out_rms_px)
-    if (std::isfinite(rms)) best = std::min(best, rms);
-  if (!std::isfinite(best)) throw InputError("knots: no knot count could be fitted to every fold of the views");
-  for (size_t k = 0; k < choice.candidates.size(); ++k)
-    if (choice.held_out_rms_px[k] <= best * (1.0 + kKnotScoreTolerance)) {
-      choice.chosen = choice.candidates[k];
-      break;
-    }
+  const int preferred = PreferredKnotCount(choice, std::vector<bool>(choice.candidates.size(), false));
+  if (preferred < 0) throw InputError("knots: no knot count could be fitted to every fold of the views");
+  choice.chosen = choice.candidates[preferred];
   return choice;
 }
 

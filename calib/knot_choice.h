@@ -38,8 +38,16 @@ struct KnotChoice {
   std::vector<double> held_out_rms_px;  // per candidate, NaN when a fold failed to fit
   int held_out_corners = 0;             // per candidate (the same corners for all)
   int folds = 0;
+  // The count the sensor was fitted with: PreferredKnotCount's among every candidate, or,
+  // where calibrate's full fit with that count was no valid mirror, its pick among the
+  // counts not yet tried (calib/calibrate.cc).
   int chosen = 0;
 };
+
+// The index of the parsimonious count among the candidates not excluded: the fewest knots
+// (no spline first) whose held-out RMS is within kKnotScoreTolerance of the lowest of
+// them; -1 when none has a score.
+int PreferredKnotCount(const KnotChoice& choice, const std::vector<bool>& excluded);
 
 // The fit options for a candidate of another shape (knot count or family): the design
 // values the priors are centred on keep every parameter the candidate shares with the

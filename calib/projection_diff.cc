@@ -43,7 +43,8 @@ Sensor WithoutCameraBody(const Sensor& sensor) {
 }
 
 // All field points at once: one batch projection per evaluation, the 2N x 6 Jacobian by
-// central differences (the batch path has no Jets; six parameters make that cheap).
+// finite differences, central where a point projects on both sides of the step (the
+// batch path has no Jets; six parameters make that cheap).
 class AlignmentCost : public ceres::CostFunction {
  public:
   AlignmentCost(const Sensor& other, Eigen::Matrix3Xd points, Eigen::Matrix2Xd targets_px)
@@ -175,6 +176,7 @@ ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, 
     // Unreachable in practice (the solver only accepts steps where every point projects).
     after = before;
     diff.aligned = false;
+    angle_axis[0] = angle_axis[1] = angle_axis[2] = translation[0] = translation[1] = translation[2] = 0.0;
   }
   const Eigen::Vector3d rotation_vector(angle_axis[0], angle_axis[1], angle_axis[2]);
   diff.rotation_deg = rotation_vector.norm() * 180.0 / M_PI;

@@ -3,8 +3,8 @@
 (radius of curvature A = 49.9582 mm, rim 43.9 mm) with a 20 um zonal figure error, as a
 polishing shop leaves one: z(r) = A - sqrt(A^2 - r^2) + e(r), e(r) = 20 um (cos(3 pi u) - 1),
 u = (r / rim)^2 (zero and flat at the vertex, 1.5 waves in u across the mirror, slope error up
-to ~1e-2 rad at the rim). Rows r, z, dz/dr in mm (the tabulated profile's format), r from
-the vertex to 0.999 A, 2001 rows. No shipped formula matches it: `calibrate --profile spline`
+to 7.9e-3 rad inside the rim, near r = 40 mm). Rows r, z, dz/dr in mm (the tabulated
+profile's format), r from the vertex to 0.999 A, 2001 rows. No shipped formula matches it: `calibrate --profile spline`
 must follow it (tests/cli/figure_error_test.sh).
 Usage: scripts/figure-error-table.py OUTPUT.csv"""
 import math

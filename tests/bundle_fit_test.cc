@@ -488,6 +488,26 @@ TEST(FitOptions, CheckRefusesInvalidSolverSettings) {
   EXPECT_EQ(options.Check(), "threads: more than 1 needs solver.use_inner_iterations off");
 }
 
+// The parsimony rule over the counts not excluded (calibrate re-applies it when the
+// folds' count fits the full set to no valid mirror). Scores as measured on the
+// figure-error set (docs/calibrate.md): 12 is within 1 % of 16's lowest, 8 is not.
+TEST(KnotChoice, PreferredCountIsTheFewestWithinOnePercentOfTheRest) {
+  KnotChoice choice;
+  choice.candidates = kKnotCandidates;
+  choice.held_out_rms_px = {0.6724, 0.2017, 0.1570, 0.1423, 0.1407, 0.1406};
+  std::vector<bool> tried(6, false);
+  EXPECT_EQ(PreferredKnotCount(choice, tried), 4);  // 12 knots
+  tried[4] = true;
+  EXPECT_EQ(PreferredKnotCount(choice, tried), 5);  // 16: the lowest left, 8 is 1.2 % above it
+  tried[5] = true;
+  EXPECT_EQ(PreferredKnotCount(choice, tried), 3);  // 8
+  choice.held_out_rms_px[2] = NAN;                   // a count whose folds failed is never picked
+  tried = {false, true, false, true, true, true};
+  EXPECT_EQ(PreferredKnotCount(choice, tried), 0);
+  tried[0] = true;
+  EXPECT_EQ(PreferredKnotCount(choice, tried), -1);
+}
+
 // The spline's knot count by held-out folds (calib/knot_choice.h), on corners with 0.1 px
 // of noise per coordinate (0.141 px per corner): the mirror of BumpedSplineProfile (a
 // 0.3 mm figure error in 6 knots) is one the 3-term polynomial cannot follow, so a spline

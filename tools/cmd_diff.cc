@@ -56,7 +56,10 @@ void RunDiff(const DiffFlags& options, const Context& context) {
   std::printf("at %.0f mm over %d pixels (%s): RMS %.4f px, median %.4f px, max %.4f px\n", options.distance_mm,
               diff.compared, field_label.c_str(), diff.rms_px, diff.median_px, diff.max_px);
   std::printf("alignment: %s, rotation %.4f deg, translation (%.3f, %.3f, %.3f) mm; before it: RMS %.4f px\n",
-              diff.aligned ? "fitted" : options.no_align ? "none (--no-align)" : "FAILED (the numbers are unaligned)", diff.rotation_deg, diff.translation_mm.x(), diff.translation_mm.y(),
+              diff.aligned        ? "fitted"
+              : options.no_align ? "none (--no-align)"
+                                 : "FAILED (the numbers are unaligned)",
+              diff.rotation_deg, diff.translation_mm.x(), diff.translation_mm.y(),
               diff.translation_mm.z(), diff.unaligned_rms_px);
 }
 
