@@ -30,7 +30,7 @@ const char* const kKnotChoiceDefinition =
     "each held out in turn while the rest are calibrated with every candidate count; candidate 0 is base_profile (no spline); held_out_rms_px over every "
     "held-out corner of every fold (poses fitted, sensor held), per corner sqrt(mean |e|^2); chosen: the fewest "
     "knots (0 first) within 1 % of the lowest, or, where the full set fitted with that count is no valid mirror, the "
-    "next count by held-out RMS whose fit is";
+    "same rule over the counts not yet tried (warning knot_count_replaced)";
 const char* const kCrossValidationDefinition =
     "the usable views split into even and odd positions, each half calibrated alone; the points distance_mm along "
     "each observed field pixel's ray through half 1 (from its reflection point), moved by the rigid motion that "
