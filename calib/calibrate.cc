@@ -413,6 +413,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     // warning below).
     const int folds_choice = choice.chosen;
     std::vector<bool> tried(choice.candidates.size(), false);
+    // The valid fit once found, else the first that fitted at all.
     std::optional<std::pair<FitResult, Sensor>> first_fitted;
     int first_fitted_knots = folds_choice;
     std::optional<FitResult> first_failed;  // its report, should no count fit at all
@@ -426,8 +427,8 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
       const std::string name = knots > 0 ? std::to_string(knots) + " knots" : base;
       if (candidate_fit.sensor && ValidateSensorModel(candidate_fit.sensor->model()).empty()) {
         valid = true;
-        choice.chosen = knots;
         first_fitted.emplace(std::move(candidate_fit), std::move(start));
+        first_fitted_knots = knots;
       } else {
         rejected += (rejected.empty() ? "" : ", ") + name + (candidate_fit.sensor ? " (no valid mirror)" : " (no fit)");
         if (!first_fitted && candidate_fit.sensor) {
@@ -440,7 +441,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     }
     if (first_fitted) {
       fit = std::move(first_fitted->first), fit_start = std::move(first_fitted->second);
-      if (!valid) choice.chosen = first_fitted_knots;
+      choice.chosen = first_fitted_knots;
     } else if (first_failed) {
       fit = std::move(*first_failed);  // no sensor: "the fit failed" below
     }
