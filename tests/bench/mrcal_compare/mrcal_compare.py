@@ -43,7 +43,7 @@ COMMAND = ("/usr/bin/python3 tests/bench/mrcal_compare/mrcal_compare.py "
 DEFINITIONS = [
     "- **RMS** (both tools, computed here from each fit's geometry): per corner, sqrt(mean over corners of "
     "|e|²), e the 2-D reprojection error in px. *All*: every corner the fit was given (omnical's outliers "
-    "projected through its fitted sensor and poses); *inliers*: the corners the tool kept. omnical's `rms_px` "
+    "projected through its fitted sensor, poses and board warp; the figure is calibrate's `rms_all_px`); *inliers*: the corners the tool kept. omnical's `rms_px` "
     "is the inlier figure.",
     "- **mrcal's own figure**, `rms_reproj_error__pixels` (what mrcal-calibrate-cameras prints), is "
     "sqrt(‖x‖² / Nmeasurements) over the solver's measurement vector (mrcal.c v2.2, end of `mrcal_optimize`): "
@@ -142,7 +142,8 @@ def sensor_label(sensor_path):
 
 def omnical_side(dataset, cli, out, log):
     """omnical's corners and its fits: full set, --holdout, --cross-validate (or diff)."""
-    from omnical_runs import Board, omnical_corner_errors, read_detections, write_detections
+    from omnical_runs import Board, omnical_corner_residuals, read_detections, write_detections
+    import residual_structure
     import numpy as np
 
     log(f"{dataset.name}: omnical detects (calibrate --images)")
@@ -162,7 +163,8 @@ def omnical_side(dataset, cli, out, log):
     views = [v for v in all_views if v["image"] in full["poses"]]  # the views omnical's fit kept
     names = [v["image"] for v in views]
     board = Board(dataset.target)
-    errors = omnical_corner_errors(cli, full, board, views)
+    residuals, view_of = omnical_corner_residuals(cli, full, board, views)
+    errors = np.linalg.norm(residuals, axis=1)
     finite = errors[np.isfinite(errors)]
     row = dict(tool="omnical", model=f"non-central: {sensor_label(os.path.join(full['_dir'], 'sensor.yaml'))}",
                params=free_parameters(full), corners=int(full.get("observations", finite.size)), views=len(views),
@@ -170,6 +172,15 @@ def omnical_side(dataset, cli, out, log):
                rms_inliers_px=float(full["rms_px"]), outliers=int(full.get("outliers", 0)),
                unprojected=int(errors.size - finite.size), seconds=full["_seconds"], holdout=None, halves=None,
                board_mm=(float(full["target_distance_mm"]["nearest"]), float(full["target_distance_mm"]["farthest"])))
+    # What a more flexible model could still learn from these residuals (residual_structure.py).
+    projected = np.all(np.isfinite(residuals), axis=1)
+    observed_px = np.concatenate([v["pixels"] for v in views])[projected]
+    board_xy = np.array([board.points_mm[i] for v in views for i in v["ids"]])[projected]
+    correlation, pairs = residual_structure.neighbour_correlation(residuals[projected], view_of[projected], board_xy)
+    row["structure"] = dict(neighbour_correlation=correlation, neighbour_pairs=pairs,
+                            pose_params=6 * len(views) + (2 if warp else 0),
+                            field=residual_structure.correction_field(observed_px, residuals[projected],
+                                                                      view_of[projected]))
 
     held = evenly_spaced(len(views), HOLDOUT_VIEWS)
     if cli.has_holdout:
@@ -209,6 +220,7 @@ def mrcal_side(dataset, omni, knots, log):
     """mrcal on omnical's corners: full set, held-out views, halves, per knot count."""
     import numpy as np
     import mrcal_fit
+    import residual_structure
 
     board, size = omni["board"], omni["image_size"]
     observed = board.observations(omni["views"])
@@ -239,6 +251,14 @@ def mrcal_side(dataset, omni, knots, log):
                    core_focal_px=float(core["problem"]["intrinsics"][0][0]),
                    core_rms_px=mrcal_fit.fit_summary(core["problem"], core["stats"], observed)["rms_all_px"],
                    **mrcal_fit.fit_summary(problem, stats, observed))
+        grid_residuals = mrcal_fit.corner_residuals(problem, observed)
+        view_index = np.broadcast_to(np.arange(len(observed))[:, None, None], seen.shape)
+        rows_cols = np.indices(seen.shape[1:]).transpose(1, 2, 0)[..., ::-1] * board.spacing_mm
+        correlation, pairs = residual_structure.neighbour_correlation(
+            grid_residuals[seen], view_index[seen], np.broadcast_to(rows_cols, seen.shape + (2,))[seen])
+        # Free parameters: the spline's values (the core is held), the poses, the warp.
+        row["structure"] = dict(neighbour_correlation=correlation, neighbour_pairs=pairs,
+                                free_params=row["intrinsics"] - 4 + 6 * len(observed) + 2)
         row["params"] = row["intrinsics"]
         trained, _ = mrcal_fit.splined_fit(cores[tuple(train)], lensmodel)
         rms, _, per_view = mrcal_fit.held_out_rms(trained, observed[held])
@@ -364,6 +384,64 @@ def interpretation(results):
     return text
 
 
+def structure_section(results):
+    """What is left in omnical's residuals for a more flexible model (residual_structure.py)."""
+    import residual_structure
+
+    out = ["", "## What is left in the residuals", "",
+           "Could a more flexible term (a figure error, lens decentering, a residual distortion) fit the corners "
+           "better *and* predict new views better? Measured on the full-set fits' residuals over all corners "
+           "(`tests/bench/mrcal_compare/residual_structure.py` defines each column):", "",
+           "| dataset | omnical RMS all (px) | neighbour correlation: omnical; mrcal per knot count | "
+           "image-plane correction field, each view left out in turn: RMS with none; best held out (knots, ridge) "
+           "| the same fields in-sample: lowest RMS (parameters) | RMS that fitting noise alone predicts for mrcal's "
+           "free parameters (measured) |", "| --- | --- | --- | --- | --- | --- |"]
+    lines = []
+    for result in results:
+        omni, mrcal_rows = result["rows"][0], result["rows"][1:]
+        structure = omni.get("structure")
+        if not structure:
+            continue
+        field = structure["field"]
+        best, richest = field["best"], field["richest"]
+        omni_params = omni["params"] + structure["pose_params"]
+        mrcal_correlations = [f"{r['structure']['neighbour_correlation']:+.3f}" for r in mrcal_rows]
+        predicted = [residual_structure.noise_fit_rms(omni["rms_all_px"], omni["corners"], omni_params,
+                                                      r["structure"]["free_params"]) for r in mrcal_rows]
+        out.append(f"| {result['dataset'].name} | {fmt(omni['rms_all_px'])} | "
+                   f"{structure['neighbour_correlation']:+.3f}; "
+                   f"{'; '.join(mrcal_correlations)} "
+                   f"({structure['neighbour_pairs']} pairs) | {fmt(field['none_rms_px'], 4)}; "
+                   f"{fmt(best['held_out_rms_px'], 4)} ({best['knots']} x {best['knots']}, {best['ridge']:g}) | "
+                   f"{fmt(richest['train_rms_px'])} ({richest['params']}) | "
+                   + "; ".join(f"{fmt(p)} ({fmt(r['rms_all_px'])}) at {r['structure']['free_params']}"
+                               for p, r in zip(predicted, mrcal_rows)) + " |")
+        gain = 1.0 - best["held_out_rms_px"] / field["none_rms_px"]
+        verdict = ("no field predicts a left-out view's residuals better than none"
+                   if gain < 0.01 else f"the best field predicts left-out views {100 * gain:.1f} % better than none")
+        lines.append(f"- **{result['dataset'].name}**: {verdict}; omnical's neighbouring corners' residuals correlate "
+                     f"{structure['neighbour_correlation']:+.3f}, mrcal's "
+                     f"{', '.join(mrcal_correlations)}; fitting "
+                     f"noise alone would bring mrcal's {', '.join(str(r['structure']['free_params']) for r in mrcal_rows)} "
+                     f"free parameters to {joined(predicted)} px against the {joined(r['rms_all_px'] for r in mrcal_rows)} "
+                     f"px they reach.")
+    if not lines:
+        return []
+    absorbed = [r["dataset"].name for r in results if r["rows"][0].get("structure")
+                and r["rows"][0]["structure"]["neighbour_correlation"] > 0.1
+                and all(m["structure"]["neighbour_correlation"] < 0.05 for m in r["rows"][1:])]
+    reading_text = ("Reading: a correction field learnt on the other views is the flexible term's best case, so "
+                    "where none helps a left-out view, what remains belongs to each view alone: neighbouring corners "
+                    "of one view may err alike (the board's own shape in that view: a hand-held paper sheet bends "
+                    "differently each time) without the error recurring where other views see the same pixels. "
+                    "Parameters that only one or two views constrain can absorb it in-sample and predict the "
+                    "held-out views worse for it")
+    if absorbed:
+        reading_text += (f": on {', '.join(absorbed)} omnical's neighbouring residuals correlate and mrcal's no "
+                         "longer do")
+    return out + [""] + lines + ["", reading_text + "."]
+
+
 def write_document(path, results, cli, quick, seconds):
     header = ["dataset", "tool / model", "intrinsic params", "corners (views)", "RMS all (px)", "RMS inliers (px)",
               "outliers", "held-out RMS (px)", f"halves diff at {DISTANCE_MM / 1000:g} m, RMS / max (px)", "time (s)"]
@@ -412,6 +490,7 @@ def write_document(path, results, cli, quick, seconds):
                        f"({result['spacing_mm']:g} mm) | {row['core_focal_px']:.1f}, {row['core_rms_px']:.2f} | "
                        f"{free} | {row['mrcal_rms_px']:.3f} | {row['mrcal_measurements']} | {warp} | "
                        f"{pair(row['halves'], 'near_diff_rms_px', 'near_diff_max_px')} |")
+    out += structure_section(results)
     out += ["", "## Definitions", ""] + DEFINITIONS + ["", "## Reading", ""] + reading(results) + ["", interpretation(results)]
     out += ["", f"Generated in {seconds:.0f} s; omnical flags found: --holdout {'yes' if cli.has_holdout else 'no'}, "
             f"--cross-validate {'yes' if cli.has_cross_validate else 'no'}, diff {'yes' if cli.has_diff else 'no'}.", ""]
@@ -431,6 +510,13 @@ def check_finite(results):
                         values += value if isinstance(value, list) else [value]
             if not all(isinstance(v, (int, float)) and math.isfinite(v) and v >= 0 for v in values):
                 raise BenchError(f"{result['dataset'].name}: {row['tool']} {row['model']}: a non-finite figure {values}")
+            structure = row.get("structure") or {}
+            figures = [structure.get("neighbour_correlation", 0.0)]
+            if "field" in structure:
+                figures += [structure["field"]["none_rms_px"], structure["field"]["best"]["held_out_rms_px"]]
+            if not all(math.isfinite(v) for v in figures):
+                raise BenchError(f"{result['dataset'].name}: {row['tool']} {row['model']}: a non-finite residual "
+                                 f"structure figure {figures}")
 
 
 def main():

@@ -201,11 +201,16 @@ def splined_fit(core, lensmodel, seed=0):
     return problem, stats
 
 
-def corner_errors(problem, observed):
-    """Per-corner |projection - observation| (px) from the fitted geometry, shape (views, H, W)."""
+def corner_residuals(problem, observed):
+    """Per-corner projection - observation (px) from the fitted geometry, shape (views, H, W, 2)."""
     camera_points = mrcal.hypothesis_board_corner_positions(**problem)[0]
     projected = mrcal.project(camera_points, problem["lensmodel"], problem["intrinsics"][0])
-    return np.linalg.norm(projected - observed[..., :2], axis=-1)
+    return projected - observed[..., :2]
+
+
+def corner_errors(problem, observed):
+    """Per-corner |projection - observation| (px) from the fitted geometry, shape (views, H, W)."""
+    return np.linalg.norm(corner_residuals(problem, observed), axis=-1)
 
 
 def fit_summary(problem, stats, observed):

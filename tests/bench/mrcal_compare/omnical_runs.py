@@ -266,18 +266,39 @@ def _project(omnical_cli, sensor_path, points_mm):
     return pixels
 
 
-def omnical_corner_errors(omnical_cli, calibration, board, views):
-    """Per-corner |projection - observation| of every corner of the views the fit used,
-    through the written sensor.yaml and the fitted poses (calibration.json "poses")."""
+def board_warp_offsets_mm(calibration, board, ids):
+    """Out-of-plane offsets (mm) of the corners `ids` under the fit's board warp
+    (calibration.json "board_warp", calib/board_warp.h): z = x_mm (1 - u^2) + y_mm (1 - v^2),
+    u, v the corner scaled to [-1, 1] over the extent of all the board's corners; 0 without one."""
+    warp = calibration.get("board_warp")
+    if not warp:
+        return np.zeros(len(ids))
+    points = np.array(list(board.points_mm.values()), dtype=float)
+    low, high = points.min(axis=0), points.max(axis=0)
+    span = np.where(high > low, high - low, 1.0)
+    xy = np.array([board.points_mm[i] for i in ids], dtype=float)
+    uv = 2.0 * (xy - low) / span - 1.0
+    basis = np.where(high > low, 1.0 - uv ** 2, 0.0)
+    return basis @ np.array([float(warp["x_mm"]), float(warp["y_mm"])])
+
+
+def omnical_corner_residuals(omnical_cli, calibration, board, views):
+    """Per-corner projection - observation (px, (N, 2), NaN where a point does not project) of
+    every corner of the views the fit used, through the written sensor.yaml, the fitted poses
+    (calibration.json "poses") and the fitted board warp; and each row's view index."""
     sensor = os.path.join(calibration["_dir"], "sensor.yaml")
-    errors = []
-    for view in views:
+    residuals, view_of = [], []
+    for index, view in enumerate(views):
         pose = calibration["poses"].get(view["image"])
         if pose is None:
             continue
         rotation = _rotation_wxyz(pose["camera_from_target_quaternion_wxyz"])
         translation = np.array(pose["camera_from_target_translation_mm"], dtype=float)
-        board_mm = np.array([(*board.points_mm[i], 0.0) for i in view["ids"]])
+        offsets = board_warp_offsets_mm(calibration, board, view["ids"])
+        board_mm = np.array([(*board.points_mm[i], z) for i, z in zip(view["ids"], offsets)])
         pixels = _project(omnical_cli, sensor, board_mm @ rotation.T + translation)
-        errors.append(np.linalg.norm(pixels - view["pixels"], axis=1))
-    return np.concatenate(errors) if errors else np.zeros(0)
+        residuals.append(pixels - view["pixels"])
+        view_of += [index] * len(view["ids"])
+    if not residuals:
+        return np.zeros((0, 2)), np.zeros(0, dtype=int)
+    return np.concatenate(residuals), np.array(view_of)
