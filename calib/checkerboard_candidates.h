@@ -83,6 +83,28 @@ struct CheckerboardCandidate {
   std::string refusal;  // why it was refused: "a patch of a larger checker pattern (...)"
 };
 
+// A found grid's corners checked against the image: findChessboardCornersSB can return
+// the outer corners of a strongly sheared board on a square's edge instead of its
+// junction (the realistic render's real001 near the rim: 2.4-12.9 px off). Three passes:
+// 1. a corner passes where XJunctionScore (steps from its grid neighbours) exceeds
+//    `threshold` and, on grid steps of 20 px and more, cornerSubPix started on it stays
+//    within max(1.5 px, 0.05 step);
+// 2. one that fails goes where cornerSubPix settled, else where its neighbours that passed
+//    predict it (the midpoint of two on a line through it, else quadratic from three on
+//    one side) pulled onto the image's junction (PullOntoJunction), if the image has an
+//    X-junction there; else it is dropped;
+// 3. (steps of 20 px and more) a corner that passed moves where a prediction from its
+//    neighbours pulls onto a junction farther than that tolerance from it: a point on an
+//    edge past cornerSubPix's window passes 1 (real001's 8.4 px corner).
+// A corner that cannot be scored (its samples leave the image) is kept as found. The
+// steps are the grid's nearest-junction distance (a sheared grid's short diagonal too).
+struct CheckedGrid {
+  std::vector<Eigen::Vector2d> corners_px;  // the grid's, re-placed ones moved
+  std::vector<bool> kept;                   // per corner: false where dropped
+  int replaced = 0, dropped = 0;
+};
+CheckedGrid CheckGridJunctions(const cv::Mat& grey, const CheckerGrid& grid, double threshold);
+
 // Up to options.max_candidates grids of `pattern` (inner corners, cols x rows) found by
 // findChessboardCornersSB (EXHAUSTIVE | ACCURACY), each found grid's region (the grid
 // extended one step on every side; a refused pattern followed outwards first) filled with

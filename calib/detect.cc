@@ -298,7 +298,14 @@ ImageDetections DetectCheckerboard(const CalibrationTarget& target, const cv::Ma
   for (const CheckerboardCandidate& candidate : found)
     if (candidate.accepted && (!best || candidate.contrast > best->contrast)) best = &candidate;
   ImageDetections image;
-  if (best) image.corners = CheckerboardCorners(target, grey, BoardCorners(best->grid.corners_px, target.cols()));
+  if (best) {
+    const CheckedGrid checked = CheckGridJunctions(grey, best->grid, options.junction_contrast_fraction * best->contrast);
+    std::vector<BoardCorner> corners;
+    const std::vector<BoardCorner> all = BoardCorners(checked.corners_px, target.cols());
+    for (size_t k = 0; k < all.size(); ++k)
+      if (checked.kept[k]) corners.push_back(all[k]);
+    image.corners = CheckerboardCorners(target, grey, corners);
+  }
   if (candidates) *candidates = std::move(found);
   return image;
 }

@@ -1,29 +1,43 @@
 #!/usr/bin/env bash
-# The realistic rendered aprilgrid set (datasets-synthetic/rendered/realistic-aprilgrid:
-# a paper board bent by 3 mm along x and -1.5 mm along y, blur, noise, vignetting, colour,
-# JPEG 85, boards near the rim and the inner radius), calibrated from its images with the
-# board's warp fitted: the warp comes back within 10 % (the issue's bound); the detector
-# finds at least 88 % of the visible corners (measured 89.6 %: a regression floor, short
-# of the 99 % wanted, see docs/detection-recall.md) within 0.3 px RMS. The sphere's
-# parameters against the truth are printed in std (the issue wants each within 3).
-# Usage: realistic_render_test.sh OMNICAL_BINARY SOURCE_DIR
+# The realistic rendered sets (datasets-synthetic/rendered/realistic-aprilgrid and
+# realistic-checkerboard: a paper board bent by 3 mm along x and -1.5 / 1 mm along y,
+# blur, noise, vignetting, colour, JPEG 85, boards near the rim and the inner radius),
+# calibrated from their images through the design guess with the board's warp and the
+# lens distortion fitted (the truth has none). The issue's bounds: the warp within 10 %,
+# every fitted parameter within 3 reported std of the truth (in the sphere's tilt gauge,
+# sphere_truth.py), no view left out. Measured: aprilgrid within 1.7 std, checkerboard
+# within 2.2 std (fx, m and k2 4.7-4.8 std off before calib/checkerboard_candidates.h's
+# junction check put real001's sheared corners back on their junctions; its corners were
+# then 0.695 px RMS from the truth, which the last check here catches; and inner1, the
+# bent board at the inner radius, was refused as 0.66 x its size until
+# calib/board_scale.h's ratio went from 1.5 to 1.65). Detection: found corners above
+# a regression floor, 98 % (aprilgrid, measured 98.6 %) and 97 % (checkerboard, 97.7 %:
+# rim corners squeezed under 3 px are dropped, calib/detect.cc), short of the 99 %
+# wanted; within 0.3 px RMS of the truth.
+# Usage: realistic_render_test.sh OMNICAL_BINARY SOURCE_DIR [aprilgrid|checkerboard]
 set -u
 omnical=$1
 source_dir=$(cd "$2" && pwd)
+kind=${3:-aprilgrid}
 data=$source_dir/datasets-synthetic
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-set_dir=$data/rendered/realistic-aprilgrid
+set_dir=$data/rendered/realistic-$kind
+case $kind in
+  aprilgrid) target=$data/targets/aprilgrid-6x6-30mm.yaml floor=0.98 ;;
+  checkerboard) target=$data/targets/checkerboard-8x6-30mm.yaml floor=0.97 ;;
+  *) echo "FAIL: unknown set kind '$kind'"; exit 1 ;;
+esac
 
-"$omnical" -q calibrate --target "$data/targets/aprilgrid-6x6-30mm.yaml" --images "$set_dir" \
-  --sensor "$data/sensors/ohte-sph-misaligned-guess.yaml" --fix distortion --board-warp --threads 2 --out "$work/cal" 2>/dev/null ||
+"$omnical" -q calibrate --target "$target" --images "$set_dir" \
+  --sensor "$data/sensors/ohte-sph-misaligned-guess.yaml" --board-warp --threads 2 --out "$work/cal" 2>/dev/null ||
   { echo "FAIL: calibrate exited $?"; exit 1; }
 
-OMNICAL_CLI_TESTS=$source_dir/tests/cli python3 - "$set_dir" "$work/cal" <<'PY'
+OMNICAL_CLI_TESTS=$source_dir/tests/cli python3 - "$set_dir" "$work/cal" "$floor" <<'PY'
 import glob, json, math, os, sys
 sys.path.insert(0, os.environ["OMNICAL_CLI_TESTS"])
 import sphere_truth
-render, cal = sys.argv[1], sys.argv[2]
+render, cal, floor = sys.argv[1], sys.argv[2], float(sys.argv[3])
 failed = []
 def check(ok, what):
     print(("ok   " if ok else "FAIL ") + what)
@@ -40,8 +54,10 @@ for axis, expected in zip("xy", truth_warp):
 p = result["parameters"]
 for name, value in sphere_truth.truth_parameters(os.path.join(render, "sensor.yaml")).items():
     if not p[name]["fixed"]:
-        print("info %s %.5g +- %.3g vs truth %.5g: %.1f std" % (name, p[name]["value"], p[name]["std"], value,
-                                                             (p[name]["value"] - value) / p[name]["std"]))
+        z = (p[name]["value"] - value) / p[name]["std"]
+        check(abs(z) <= 3.0, "%s %.5g +- %.3g vs truth %.5g: %.1f std (within 3)" % (name, p[name]["value"], p[name]["std"], value, z))
+images = sorted(glob.glob(os.path.join(render, "*.jpg")))
+check(len(result["poses"]) == len(images), "%d of %d views in the fit" % (len(result["poses"]), len(images)))
 det = json.load(open(os.path.join(cal, "detections.json")))
 visible = found = 0
 squares = []
@@ -56,7 +72,7 @@ for path in glob.glob(os.path.join(render, "*.json")):
     gt = json.load(open(path))
     if "targets" in gt: visible += sum(1 for c in gt["targets"][0]["corners"] if c["visible"])
 rms = math.sqrt(sum(squares) / len(squares))
-check(found >= 0.88 * visible, "found %d of %d visible corners (%.1f %%, floor 88 %%)" % (found, visible, 100.0 * found / visible))
+check(found >= floor * visible, "found %d of %d visible corners (%.1f %%, floor %g %%)" % (found, visible, 100.0 * found / visible, 100 * floor))
 check(rms < 0.3, "refined corners %.3f px RMS from the ground truth (< 0.3)" % rms)
 sys.exit(1 if failed else 0)
 PY
