@@ -392,22 +392,32 @@ TEST(RefineCorners, ConvergesFromAPixelOffOrKeepsTheStart) {
 // turned by `angle_deg` about `origin_px`; where `inside` says false, paper or the
 // background. Levels as a print under even light: ink 40, paper 220.
 constexpr double kInk = 40.0, kPaper = 220.0;
-cv::Mat DrawChecker(int size_px, double square_px, double angle_deg, const Eigen::Vector2d& origin_px,
+// Each pixel the mean of 4 x 4 samples' square levels; `to_pattern` maps a sample's offset
+// from `origin_px` to pattern units.
+cv::Mat DrawPattern(int size_px, const Eigen::Vector2d& origin_px,
+                    const std::function<Eigen::Vector2d(const Eigen::Vector2d&)>& to_pattern,
                     const std::function<double(int, int)>& level_of_square) {
-  const double c = std::cos(angle_deg * M_PI / 180.0), s = std::sin(angle_deg * M_PI / 180.0);
   cv::Mat image(size_px, size_px, CV_8U);
   for (int v = 0; v < size_px; ++v)
     for (int u = 0; u < size_px; ++u) {
       double sum = 0.0;
       for (int j = 0; j < 4; ++j)
         for (int i = 0; i < 4; ++i) {
-          const Eigen::Vector2d d(u - 0.375 + 0.25 * i - origin_px.x(), v - 0.375 + 0.25 * j - origin_px.y());
-          const double a = (c * d.x() + s * d.y()) / square_px, b = (-s * d.x() + c * d.y()) / square_px;
-          sum += level_of_square(static_cast<int>(std::floor(a)), static_cast<int>(std::floor(b)));
+          const Eigen::Vector2d ab =
+              to_pattern(Eigen::Vector2d(u - 0.375 + 0.25 * i - origin_px.x(), v - 0.375 + 0.25 * j - origin_px.y()));
+          sum += level_of_square(static_cast<int>(std::floor(ab.x())), static_cast<int>(std::floor(ab.y())));
         }
       image.at<uchar>(v, u) = cv::saturate_cast<uchar>(sum / 16.0);
     }
   return image;
+}
+
+cv::Mat DrawChecker(int size_px, double square_px, double angle_deg, const Eigen::Vector2d& origin_px,
+                    const std::function<double(int, int)>& level_of_square) {
+  const double c = std::cos(angle_deg * M_PI / 180.0), s = std::sin(angle_deg * M_PI / 180.0);
+  return DrawPattern(size_px, origin_px, [&](const Eigen::Vector2d& d) {
+    return Eigen::Vector2d((c * d.x() + s * d.y()) / square_px, (-s * d.x() + c * d.y()) / square_px);
+  }, level_of_square);
 }
 
 // The pixel of pattern corner (a, b) (square units) for DrawChecker's pose.
@@ -484,13 +494,6 @@ TEST(CheckerboardCandidates, RefusesAWindowIntoALargerPatternAcceptsABoardWithAM
       << on_tiles[0].refusal;
 }
 
-// findChessboardCornersSB's failure on the realistic render's sheared board (real001: the
-// first column's corners on a square's edge, 2.4-12.9 px from their junctions) on a drawn
-// board (30 px squares, blurred 0.8 px like the render): a corner moved 8 px and one 3 px
-// along their grid lines come back to their junctions; a corner whose squares do not meet
-// as an X (one ink square printed white: its four corners) is dropped; every other corner
-// is returned exactly as given. 0.3 px: cornerSubPix's accuracy on a blurred antialiased
-// junction (the drawing's own corners are exact), well under the 3-8 px being corrected.
 // A sheared checker (pattern axes `axis_a_px`, `axis_b_px` from `origin_px`: squares drawn as
 // parallelograms, as a board at a grazing angle near the rim images), 4 x 4 supersampled;
 // its inner corners (1..8, 1..6) as the grid.
@@ -499,19 +502,9 @@ cv::Mat DrawShearedChecker(int size_px, const Eigen::Vector2d& axis_a_px, const 
   Eigen::Matrix2d axes;
   axes << axis_a_px, axis_b_px;
   const Eigen::Matrix2d to_pattern = axes.inverse();
-  cv::Mat image(size_px, size_px, CV_8U);
-  for (int v = 0; v < size_px; ++v)
-    for (int u = 0; u < size_px; ++u) {
-      double sum = 0.0;
-      for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i) {
-          const Eigen::Vector2d ab =
-              to_pattern * Eigen::Vector2d(u - 0.375 + 0.25 * i - origin_px.x(), v - 0.375 + 0.25 * j - origin_px.y());
-          const int a = static_cast<int>(std::floor(ab.x())), b = static_cast<int>(std::floor(ab.y()));
-          sum += (a >= 0 && a < 9 && b >= 0 && b < 7) ? ((a + b) % 2 ? kPaper : kInk) : kPaper;
-        }
-      image.at<uchar>(v, u) = cv::saturate_cast<uchar>(sum / 16.0);
-    }
+  const cv::Mat image = DrawPattern(
+      size_px, origin_px, [&](const Eigen::Vector2d& d) { return Eigen::Vector2d(to_pattern * d); },
+      [](int a, int b) { return (a >= 0 && a < 9 && b >= 0 && b < 7) ? ((a + b) % 2 ? kPaper : kInk) : kPaper; });
   grid->rows = 6, grid->cols = 8;
   grid->corners_px.clear();
   for (int r = 1; r <= 6; ++r)
@@ -519,6 +512,14 @@ cv::Mat DrawShearedChecker(int size_px, const Eigen::Vector2d& axis_a_px, const 
   return image;
 }
 
+// findChessboardCornersSB's failure on the realistic render's sheared board (real001: the
+// first column's corners on a square's edge, 2.4-12.9 px from their junctions) on a drawn
+// board (30 px squares, blurred 0.8 px like the render): corners moved 8, 3 and 12 px
+// along their grid lines come back to their junctions, and one 8 px off on a board sheared
+// to 35 deg between its axes; a corner whose squares do not meet
+// as an X (one ink square printed white: its four corners) is dropped; every other corner
+// is returned exactly as given. 0.3 px: cornerSubPix's accuracy on a blurred antialiased
+// junction (the drawing's own corners are exact), well under the 3-8 px being corrected.
 TEST(CheckGridJunctions, PutsCornersOffTheirJunctionBackAndDropsOnesWithoutAJunction) {
   constexpr double kSquare = 30.0, kAngle = 15.0;
   const Eigen::Vector2d origin(80.0, 60.0);
@@ -572,7 +573,9 @@ TEST(CheckGridJunctions, PutsCornersOffTheirJunctionBackAndDropsOnesWithoutAJunc
   // line sits on a square's edge where cornerSubPix, started there, barely moves; the
   // junction a prediction from its neighbours pulls onto gives it away.
   CheckerGrid sheared;
-  cv::Mat image = DrawShearedChecker(480, Eigen::Vector2d(40.0, 0.0), Eigen::Vector2d(40.0 * std::cos(35.0 * M_PI / 180.0), 40.0 * std::sin(35.0 * M_PI / 180.0)),
+  const double shear_rad = 35.0 * M_PI / 180.0;
+  cv::Mat image = DrawShearedChecker(480, Eigen::Vector2d(40.0, 0.0),
+                                     Eigen::Vector2d(40.0 * std::cos(shear_rad), 40.0 * std::sin(shear_rad)),
                                      Eigen::Vector2d(20.0, 120.0), &sheared);
   cv::GaussianBlur(image, image, cv::Size(0, 0), 0.8);
   CheckerGrid off = sheared;
