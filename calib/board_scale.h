@@ -23,10 +23,12 @@
 namespace omnical {
 
 struct BoardScaleOptions {
+  // Applied both ways (refused above 1.65 or below 1 / 1.65 = 0.61 x the target's size).
   // True boards, through a fit their own noise (and a decoy's pull) bends, have been seen
-  // to fit best at 1 / 0.70 = 1.43 (tests/calibration_trust_test.cc, a 4x giant in the set)
-  // and at 1 / 0.66 = 1.52 (the realistic render's bent board at the inner radius, inner1);
-  // the distant giants 4 and 10 times the size at 1.79 and 2.01.
+  // to fit best at 0.70 x their size (a ratio of 1.43; tests/calibration_trust_test.cc,
+  // a 4x giant in the set) and at 0.66 x (1.52: the realistic render's bent board at the
+  // inner radius, inner1); the distant giants 4 and 10 times the size at 1.79 and 2.01 x.
+  // No decoy smaller than the board has been measured.
   double max_size_ratio = 1.65;
   double min_chi2 = 25.0;
 };

@@ -190,104 +190,148 @@ bool PullOntoJunction(const cv::Mat& grey, double step_px, Eigen::Vector2d* poin
 
 CheckedGrid CheckGridJunctions(const cv::Mat& grey, const CheckerGrid& grid, double threshold) {
   const int count = grid.rows * grid.cols;
-  CheckerGrid working = grid;  // predictions use the corners as re-placed so far
-  std::vector<bool> good(count, true), replaced(count, false);
+  CheckerGrid working = grid;  // the corners as re-placed so far
+  std::vector<bool> good(count, true), replaced(count, false), dropped(count, false);
   auto is_good = [&](int r, int c) { return r >= 0 && c >= 0 && r < grid.rows && c < grid.cols && good[r * grid.cols + c]; };
-  auto steps_at = [&](int r, int c) {
-    std::vector<Eigen::Vector2d> row, column;
-    for (int k = 0; k < grid.cols; ++k) row.push_back(working.at(r, k));
-    for (int k = 0; k < grid.rows; ++k) column.push_back(working.at(k, c));
-    return std::pair<Eigen::Vector2d, Eigen::Vector2d>{AlongStep(row, c), AlongStep(column, r)};
+  // The grid step through (r, c) along (dr, dc) from its neighbours that passed, never from
+  // the corner itself (an end corner off its junction would shorten its own step).
+  auto step_along = [&](int r, int c, int dr, int dc) -> Eigen::Vector2d {
+    if (is_good(r - dr, c - dc) && is_good(r + dr, c + dc))
+      return 0.5 * (working.at(r + dr, c + dc) - working.at(r - dr, c - dc));
+    for (const int sign : {1, -1})
+      if (is_good(r + sign * dr, c + sign * dc) && is_good(r + 2 * sign * dr, c + 2 * sign * dc))
+        return sign * (working.at(r + 2 * sign * dr, c + 2 * sign * dc) - working.at(r + sign * dr, c + sign * dc));
+    std::vector<Eigen::Vector2d> line;  // no two neighbours passed: the found grid's own step
+    for (int k = 0; k < (dr ? grid.rows : grid.cols); ++k) line.push_back(dr ? grid.at(k, c) : grid.at(r, k));
+    return AlongStep(line, dr ? r : c);
   };
   auto score_at = [&](const Eigen::Vector2d& point, int r, int c) {
-    const auto [along_row, along_column] = steps_at(r, c);
-    return XJunctionScore(grey, point, along_row, along_column);
+    return XJunctionScore(grey, point, step_along(r, c, 0, 1), step_along(r, c, 1, 0));
   };
-  // The distance to the nearest other junction (a sheared grid's short diagonal may be the
-  // nearest): PullOntoJunction's window stays clear of it.
+  // The distance to the nearest other junction (on a sheared grid the short diagonal):
+  // cornerSubPix's window (PullOntoJunction: 0.3 of it) then stays clear of other junctions.
   auto step_at = [&](int r, int c) {
-    const auto [along_row, along_column] = steps_at(r, c);
-    return std::min({along_row.norm(), along_column.norm(), (along_row - along_column).norm(),
-                     (along_row + along_column).norm()});
+    const Eigen::Vector2d a = step_along(r, c, 0, 1), b = step_along(r, c, 1, 0);
+    return std::min({a.norm(), b.norm(), (a - b).norm(), (a + b).norm()});
   };
   // cornerSubPix started on a corner of the detector's settles within this of it (renders:
-  // 0.1-0.9 px); started on a square's edge it travels 2.5-10 px. On squares under
+  // 0.1-0.9 px); started on a square's edge it travels 2.5-10 px. On steps under
   // kMinPullStepPx its window holds too few pixels to judge the detector by: on the real
   // Mei images (9-15 px squares) it moved two corners that fitted at 0.2 px by 1.5-2 px.
   auto tolerance_px = [](double step_px) { return std::max(1.5, 0.05 * step_px); };
   constexpr double kMinPullStepPx = 20.0;
-  // Where the corner's neighbours that passed put it: the midpoint of two on a line through
-  // it, else quadratic from three on one side; with the grid step there.
-  auto predictions = [&](int r, int c) {
-    std::vector<std::pair<Eigen::Vector2d, double>> out;
-    for (const auto& [dr, dc] : {std::pair<int, int>{0, 1}, {1, 0}}) {
-      if (is_good(r - dr, c - dc) && is_good(r + dr, c + dc)) {
-        const Eigen::Vector2d a = working.at(r - dr, c - dc), b = working.at(r + dr, c + dc);
-        out.push_back({0.5 * (a + b), 0.5 * (b - a).norm()});
-        continue;
-      }
-      for (const int sign : {1, -1}) {
-        const int r1 = r + sign * dr, c1 = c + sign * dc, r2 = r + 2 * sign * dr, c2 = c + 2 * sign * dc,
-                  r3 = r + 3 * sign * dr, c3 = c + 3 * sign * dc;
-        if (is_good(r1, c1) && is_good(r2, c2) && is_good(r3, c3)) {
-          const Eigen::Vector2d p1 = working.at(r1, c1), p2 = working.at(r2, c2), p3 = working.at(r3, c3);
-          out.push_back({3.0 * p1 - 3.0 * p2 + p3, (p1 - p2).norm()});
-          break;
+  // A junction at `point` for corner (r, c): X-shaped there and, on steps >= kMinPullStepPx,
+  // where cornerSubPix settles when started on it and again when started a tenth of a step
+  // away along either grid line: on a straight edge it only moves across the edge, so starts
+  // along it stay apart (an edge point passes the X test when the junction is within a
+  // quarter step). Returns where cornerSubPix settled.
+  auto junction_at = [&](Eigen::Vector2d point, int r, int c) -> std::optional<Eigen::Vector2d> {
+    const double step_px = step_at(r, c);
+    if (step_px >= kMinPullStepPx) {
+      const Eigen::Vector2d start = point;
+      if (!PullOntoJunction(grey, step_px, &point) || (point - start).norm() > tolerance_px(step_px)) return std::nullopt;
+      const double agree_px = std::max(0.5, 0.03 * step_px);
+      for (const Eigen::Vector2d& along : {step_along(r, c, 0, 1), step_along(r, c, 1, 0)})
+        for (const double sign : {1.0, -1.0}) {
+          Eigen::Vector2d from = point + sign * 0.1 * step_px * along.normalized();
+          if (!PullOntoJunction(grey, step_px, &from) || (from - point).norm() > agree_px) return std::nullopt;
+        }
+    }
+    if (!(score_at(point, r, c) > threshold)) return std::nullopt;
+    return point;
+  };
+  // Where the corner's neighbours that passed put it, pulled onto the image's junction:
+  // one-sided (quadratic from three towards the board's inside) first, then midpoints of
+  // two on a line through it. An edge row or column the detector misplaced as a whole
+  // agrees with itself; the lines across it do not. nullopt: no prediction pulled.
+  enum class Verdict { kNone, kConfirms, kElsewhere };
+  // Every prediction's junction, in that order.
+  auto predicted_all = [&](int r, int c) {
+    std::vector<Eigen::Vector2d> guesses;
+    for (const bool one_sided : {true, false})
+      for (const auto& [dr, dc] : {std::pair<int, int>{0, 1}, {1, 0}}) {
+        const bool both = is_good(r - dr, c - dc) && is_good(r + dr, c + dc);
+        if (!one_sided && both) guesses.push_back(0.5 * (working.at(r - dr, c - dc) + working.at(r + dr, c + dc)));
+        if (!one_sided || both) continue;
+        for (const int sign : {1, -1}) {
+          const int r1 = r + sign * dr, c1 = c + sign * dc, r2 = r + 2 * sign * dr, c2 = c + 2 * sign * dc,
+                    r3 = r + 3 * sign * dr, c3 = c + 3 * sign * dc;
+          if (is_good(r1, c1) && is_good(r2, c2) && is_good(r3, c3)) {
+            guesses.push_back(3.0 * working.at(r1, c1) - 3.0 * working.at(r2, c2) + working.at(r3, c3));
+            break;
+          }
         }
       }
+    const double step_px = step_at(r, c);
+    std::vector<std::pair<Verdict, Eigen::Vector2d>> out;
+    for (Eigen::Vector2d guess : guesses) {
+      if (!PullOntoJunction(grey, step_px, &guess)) continue;
+      const std::optional<Eigen::Vector2d> junction = junction_at(guess, r, c);
+      if (!junction) continue;
+      out.push_back({(*junction - working.at(r, c)).norm() <= tolerance_px(step_px) ? Verdict::kConfirms
+                                                                                     : Verdict::kElsewhere,
+                     *junction});
     }
     return out;
+  };
+  auto predicted = [&](int r, int c, Eigen::Vector2d* where) {
+    const auto all = predicted_all(r, c);
+    if (all.empty()) return Verdict::kNone;
+    *where = all.front().second;
+    return all.front().first;
   };
   auto replace = [&](int r, int c, const Eigen::Vector2d& point) {
     working.corners_px[r * grid.cols + c] = point;
     replaced[r * grid.cols + c] = good[r * grid.cols + c] = true;
   };
 
-  // 1. Each corner on its own: an X-junction there, and cornerSubPix stays near it.
-  std::vector<std::optional<Eigen::Vector2d>> pulled(count);
+  // 1. Each corner on its own. Not testable (samples off the image): kept as found.
+  std::vector<bool> testable(count, true);
   for (int r = 0; r < grid.rows; ++r)
     for (int c = 0; c < grid.cols; ++c) {
       const int index = r * grid.cols + c;
-      const double score = score_at(grid.at(r, c), r, c);
-      if (std::isnan(score)) continue;  // not testable (near the image's edge): kept as found
-      const double step_px = step_at(r, c);
-      Eigen::Vector2d point = grid.at(r, c);
-      if (PullOntoJunction(grey, step_px, &point)) pulled[index] = point;
-      good[index] = score > threshold && (step_px < kMinPullStepPx ||
-                                          (pulled[index] && (point - grid.at(r, c)).norm() <= tolerance_px(step_px)));
+      testable[index] = !std::isnan(score_at(grid.at(r, c), r, c));
+      good[index] = !testable[index] || junction_at(grid.at(r, c), r, c).has_value();
     }
-  // 2. The ones that failed: where cornerSubPix settled, else a prediction pulled onto the
-  // image's junction, kept where the image has an X-junction; dropped otherwise.
-  std::vector<bool> dropped(count, false);
+  // 2. The ones that failed, against their neighbours that passed (and those re-placed
+  // before them): a corner that passes now (its steps were its own bad neighbours') stays;
+  // else the junction a prediction pulls onto, or where cornerSubPix settles from the
+  // corner; else dropped.
   for (int r = 0; r < grid.rows; ++r)
     for (int c = 0; c < grid.cols; ++c) {
       const int index = r * grid.cols + c;
       if (good[index]) continue;
-      std::vector<std::pair<Eigen::Vector2d, double>> tries;
-      if (pulled[index]) tries.push_back({*pulled[index], step_at(r, c)});
-      for (const auto& prediction : predictions(r, c)) tries.push_back(prediction);
-      for (auto [point, step_px] : tries)
-        if (PullOntoJunction(grey, step_px, &point) && score_at(point, r, c) > threshold) {
-          replace(r, c, point);
-          break;
+      if (junction_at(grid.at(r, c), r, c)) {
+        good[index] = true;
+        continue;
+      }
+      Eigen::Vector2d where = grid.at(r, c);
+      if (predicted(r, c, &where) != Verdict::kNone) {
+        replace(r, c, where);
+        continue;
+      }
+      Eigen::Vector2d settled = grid.at(r, c);
+      if (PullOntoJunction(grey, step_at(r, c), &settled)) {
+        if (const std::optional<Eigen::Vector2d> junction = junction_at(settled, r, c)) {
+          replace(r, c, *junction);
+          continue;
         }
-      dropped[index] = !good[index];
+      }
+      dropped[index] = true;
     }
-  // 3. Every other corner against its neighbours: the junction a prediction from them pulls
-  // onto must be the corner itself (a corner on a square's edge whose own window could not
-  // see the junction passes 1).
+  // 3. Every other testable corner against its neighbours (steps >= kMinPullStepPx): a
+  // point on a square's edge past cornerSubPix's window can pass 1. It moves to the
+  // junction the first prediction pulls onto when no prediction pulls onto the corner.
   for (int r = 0; r < grid.rows; ++r)
     for (int c = 0; c < grid.cols; ++c) {
       const int index = r * grid.cols + c;
-      if (!good[index] || replaced[index] || step_at(r, c) < kMinPullStepPx) continue;
+      if (!good[index] || replaced[index] || !testable[index] || step_at(r, c) < kMinPullStepPx) continue;
       good[index] = false;  // not its own neighbour
-      const auto tries = predictions(r, c);
+      const auto all = predicted_all(r, c);
       good[index] = true;
-      if (tries.empty()) continue;
-      auto [point, step_px] = tries.front();
-      if (PullOntoJunction(grey, step_px, &point) && (point - grid.at(r, c)).norm() > tolerance_px(step_px) &&
-          score_at(point, r, c) > threshold)
-        replace(r, c, point);
+      bool confirmed = false;
+      for (const auto& prediction : all) confirmed = confirmed || prediction.first == Verdict::kConfirms;
+      if (!confirmed && !all.empty()) replace(r, c, all.front().second);
     }
   CheckedGrid out;
   out.corners_px = working.corners_px;

@@ -513,13 +513,18 @@ cv::Mat DrawShearedChecker(int size_px, const Eigen::Vector2d& axis_a_px, const 
 }
 
 // findChessboardCornersSB's failure on the realistic render's sheared board (real001: the
-// first column's corners on a square's edge, 2.4-12.9 px from their junctions) on a drawn
-// board (30 px squares, blurred 0.8 px like the render): corners moved 8, 3 and 12 px
-// along their grid lines come back to their junctions, and one 8 px off on a board sheared
-// to 35 deg between its axes; a corner whose squares do not meet
-// as an X (one ink square printed white: its four corners) is dropped; every other corner
-// is returned exactly as given. 0.3 px: cornerSubPix's accuracy on a blurred antialiased
-// junction (the drawing's own corners are exact), well under the 3-8 px being corrected.
+// first column's corners on a square's edge, 2.4-12.9 px from their junctions) on drawn
+// boards blurred 0.8 px like the render. 30 px squares: corners moved 8, 3 and 12 px along
+// their grid lines come back to their junctions; a corner whose squares do not meet as an
+// X (one ink square printed white: its four corners are L corners) is dropped; every other
+// corner is returned exactly as given. Sheared boards: one 8 px off on a board with 35 deg
+// between its axes (pass 1 moves it), one 8 px along its row that cornerSubPix started on
+// it does not move (only the neighbours' prediction, pass 3, finds it), and a whole first
+// column 10 px off on 60 px squares 20 deg apart, where cornerSubPix with a window sized
+// by the grid step (not the short diagonal) drifts 7-9 px even from a true junction.
+// 0.3 px: cornerSubPix's accuracy on a blurred antialiased junction (the drawing's own
+// corners are exact; measured 0.01-0.09 px), well under the 3-12 px being corrected; 0.5
+// px at 20 deg, whose acute wedges are ~4 px wide in cornerSubPix's window (measured 0.44).
 TEST(CheckGridJunctions, PutsCornersOffTheirJunctionBackAndDropsOnesWithoutAJunction) {
   constexpr double kSquare = 30.0, kAngle = 15.0;
   const Eigen::Vector2d origin(80.0, 60.0);
@@ -533,77 +538,113 @@ TEST(CheckGridJunctions, PutsCornersOffTheirJunctionBackAndDropsOnesWithoutAJunc
   };
   const CheckerGrid truth = TrueGrid(kSquare, kAngle, origin);
   const double threshold = 0.3 * (kPaper - kInk);
+  // Every corner of `checked` within `tolerance_px` of `truth`'s where listed in `moved`,
+  // exactly `given`'s elsewhere.
+  auto expect_back = [](const CheckedGrid& checked, const CheckerGrid& given, const CheckerGrid& truth,
+                        const std::set<int>& moved, double tolerance_px = 0.3) {
+    for (size_t k = 0; k < given.corners_px.size(); ++k) {
+      if (moved.count(static_cast<int>(k))) {
+        EXPECT_LT((checked.corners_px[k] - truth.corners_px[k]).norm(), tolerance_px) << "corner " << k;
+      } else {
+        EXPECT_EQ(checked.corners_px[k], given.corners_px[k]) << "corner " << k;
+      }
+    }
+  };
 
   const CheckedGrid clean = CheckGridJunctions(draw(false), truth, threshold);
   EXPECT_EQ(clean.replaced, 0);
   EXPECT_EQ(clean.dropped, 0);
-  for (size_t k = 0; k < truth.corners_px.size(); ++k) EXPECT_EQ(clean.corners_px[k], truth.corners_px[k]) << k;
+  expect_back(clean, truth, truth, {});
 
   CheckerGrid found = truth;
   const Eigen::Vector2d along_row = (truth.at(0, 1) - truth.at(0, 0)).normalized();
   const Eigen::Vector2d along_column = (truth.at(1, 0) - truth.at(0, 0)).normalized();
-  found.corners_px[0 * found.cols + 0] += 8.0 * along_row;
-  found.corners_px[2 * found.cols + 0] += 3.0 * along_column;
-  // 12 px: past cornerSubPix's window (0.3 of a step), where it sees one straight edge and
-  // stays; the junction its neighbours' prediction pulls onto gives it away.
   const int far = 5 * found.cols + 7;
+  found.corners_px[0] += 8.0 * along_row;
+  found.corners_px[2 * found.cols] += 3.0 * along_column;
   found.corners_px[far] -= 12.0 * along_column;
   const CheckedGrid checked = CheckGridJunctions(draw(false), found, threshold);
   EXPECT_EQ(checked.replaced, 3);
   EXPECT_EQ(checked.dropped, 0);
-  EXPECT_LT((checked.corners_px[0] - truth.at(0, 0)).norm(), 0.3);
-  EXPECT_LT((checked.corners_px[2 * found.cols] - truth.at(2, 0)).norm(), 0.3);
-  EXPECT_LT((checked.corners_px[far] - truth.corners_px[far]).norm(), 0.3);
-  for (size_t k = 0; k < found.corners_px.size(); ++k) {
-    if (k == 0 || k == static_cast<size_t>(2 * found.cols) || k == static_cast<size_t>(far)) continue;
-    EXPECT_EQ(checked.corners_px[k], found.corners_px[k]) << k;
-  }
+  expect_back(checked, found, truth, {0, 2 * found.cols, far});
 
   // Square (4, 4) is ink; printed white, its corners (pattern units (4, 4), (5, 4), (4, 5),
-  // (5, 5): grid (row, col) = (3, 3), (3, 4), (4, 3), (4, 4)) are T-junctions, not X.
+  // (5, 5): grid (row, col) = (3, 3), (3, 4), (4, 3), (4, 4)) are L corners, not X.
   const CheckedGrid hidden = CheckGridJunctions(draw(true), truth, threshold);
   EXPECT_EQ(hidden.dropped, 4);
+  EXPECT_EQ(hidden.replaced, 0);
   for (int r = 0; r < truth.rows; ++r)
     for (int c = 0; c < truth.cols; ++c) {
       const bool on_hidden_square = (r == 3 || r == 4) && (c == 3 || c == 4);
       EXPECT_EQ(hidden.kept[r * truth.cols + c], !on_hidden_square) << r << " " << c;
+      if (!on_hidden_square) {
+        EXPECT_EQ(hidden.corners_px[r * truth.cols + c], truth.at(r, c)) << r << " " << c;
+      }
     }
 
-  // Strongly sheared squares (axes 35 deg apart): a corner 8 px along a grid
-  // line sits on a square's edge where cornerSubPix, started there, barely moves; the
-  // junction a prediction from its neighbours pulls onto gives it away.
+  auto sheared_board = [](double square_px, double between_axes_deg, CheckerGrid* grid) {
+    const double angle = between_axes_deg * M_PI / 180.0;
+    cv::Mat image = DrawShearedChecker(
+        640, Eigen::Vector2d(square_px, 0.0), Eigen::Vector2d(square_px * std::cos(angle), square_px * std::sin(angle)),
+        Eigen::Vector2d(10.0, 10.0), grid);
+    cv::GaussianBlur(image, image, cv::Size(0, 0), 0.8);
+    return image;
+  };
   CheckerGrid sheared;
-  const double shear_rad = 35.0 * M_PI / 180.0;
-  cv::Mat image = DrawShearedChecker(480, Eigen::Vector2d(40.0, 0.0),
-                                     Eigen::Vector2d(40.0 * std::cos(shear_rad), 40.0 * std::sin(shear_rad)),
-                                     Eigen::Vector2d(20.0, 120.0), &sheared);
-  cv::GaussianBlur(image, image, cv::Size(0, 0), 0.8);
+  const cv::Mat at_35 = sheared_board(40.0, 35.0, &sheared);
+  ASSERT_LT(sheared.at(5, 7).x(), 600.0);  // every corner testable
   CheckerGrid off = sheared;
   off.corners_px[0] += 8.0 * (sheared.at(1, 0) - sheared.at(0, 0)).normalized();
-  const CheckedGrid back = CheckGridJunctions(image, off, threshold);
-  EXPECT_EQ(back.replaced, 1);
+  const int along_its_row = 1 * off.cols + 2;
+  off.corners_px[along_its_row] += 8.0 * (sheared.at(1, 3) - sheared.at(1, 2)).normalized();
+  const CheckedGrid back = CheckGridJunctions(at_35, off, threshold);
+  EXPECT_EQ(back.replaced, 2);
   EXPECT_EQ(back.dropped, 0);
-  EXPECT_LT((back.corners_px[0] - sheared.at(0, 0)).norm(), 0.3);
+  expect_back(back, off, sheared, {0, along_its_row});
+
+  const cv::Mat at_20 = sheared_board(60.0, 20.0, &sheared);
+  off = sheared;
+  std::set<int> first_column;
+  for (int r = 0; r < off.rows; ++r) {
+    off.corners_px[r * off.cols] += 10.0 * (sheared.at(1, 0) - sheared.at(0, 0)).normalized();
+    first_column.insert(r * off.cols);
+  }
+  const CheckedGrid column = CheckGridJunctions(at_20, off, threshold);
+  EXPECT_EQ(column.dropped, 0);
+  expect_back(column, off, sheared, first_column, 0.5);  // measured up to 0.44 px: 20 deg wedges are thin
 }
 
-// The realistic render's real001 (a board sheared to ~20 deg between its axes near the
-// rim, JPEG 85): findChessboardCornersSB puts four corners of the first column on square
-// edges, 2.4, 3.0, 8.4 and 12.9 px from their junctions (measured before the check). With
-// CheckGridJunctions every one of the 48 is found and within 1 px of the truth (the
-// render's noise, blur and JPEG leave the detector's good corners up to 0.9 px off, in
-// the second column; the four come back to 0.05-0.36 px). Matched by position, as above.
+// The realistic render's real001 (a board near the rim whose axes meet at 32-61 deg along
+// its first column, JPEG 85): findChessboardCornersSB puts four corners of the first
+// column on square edges, 2.4, 3.0, 8.4 and 12.9 px from their junctions (measured before
+// the check). With CheckGridJunctions every one of the 48 is found, each on its own
+// junction, the first column within 0.5 px of the truth (measured 0.05-0.14 px) and the
+// rest within 1.2 px (the render's noise, blur and JPEG leave the detector's good corners
+// up to 0.9 px off, in the second column). And ohte-sph-checkerboard-near's cb002, whose
+// corners OpenCV places within 1.0 px: none moves off its junction (a version of the check
+// that trusted one quadratic prediction along the rim's curve put corner 40 9.2 px off).
+// Matched by position, as above.
 TEST(DetectCheckerboard, PutsAShearedBoardsEdgeCornersOnTheirJunctions) {
-  const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/realistic-checkerboard";
-  const DetectionSet truth = DetectionsFromGroundTruth({set + "/real001.json"});
-  const CalibrationTarget target = CalibrationTarget::FromYaml(truth.target_spec);
-  const cv::Mat grey = cv::imread(truth.images[0].image, cv::IMREAD_GRAYSCALE);
-  ASSERT_FALSE(grey.empty());
-  const ImageDetections found = DetectTarget(target, grey);
-  EXPECT_EQ(found.corners.size(), truth.images[0].corners.size());
-  for (const CornerObservation& c : found.corners) {
-    double nearest = HUGE_VAL;
-    for (const CornerObservation& t : truth.images[0].corners) nearest = std::min(nearest, (c.pixel - t.pixel).norm());
-    EXPECT_LT(nearest, 1.0) << "corner " << c.id << " at (" << c.pixel.x() << ", " << c.pixel.y() << ")";
+  const std::string sets = testing::SourceDir() + "/datasets-synthetic/rendered/";
+  for (const std::string view : {"realistic-checkerboard/real001.json", "ohte-sph-checkerboard-near/cb002.json"}) {
+    SCOPED_TRACE(view);
+    const DetectionSet truth = DetectionsFromGroundTruth({sets + view});
+    const CalibrationTarget target = CalibrationTarget::FromYaml(truth.target_spec);
+    const cv::Mat grey = cv::imread(truth.images[0].image, cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(grey.empty());
+    const ImageDetections found = DetectTarget(target, grey);
+    EXPECT_EQ(found.corners.size(), truth.images[0].corners.size());
+    std::set<int> matched;
+    for (const CornerObservation& c : found.corners) {
+      double nearest = HUGE_VAL;
+      int nearest_id = -1;
+      for (const CornerObservation& t : truth.images[0].corners)
+        if ((c.pixel - t.pixel).norm() < nearest) nearest = (c.pixel - t.pixel).norm(), nearest_id = t.id;
+      EXPECT_TRUE(matched.insert(nearest_id).second) << "two corners on truth corner " << nearest_id;
+      const bool real001_first_column = view.find("real001") != std::string::npos && nearest_id % target.cols() == 0;
+      EXPECT_LT(nearest, real001_first_column ? 0.5 : 1.2)
+          << "corner " << c.id << " at (" << c.pixel.x() << ", " << c.pixel.y() << ")";
+    }
   }
 }
 

@@ -285,9 +285,10 @@ def board_warp_offsets_mm(calibration, board, ids):
 def omnical_corner_residuals(omnical_cli, calibration, board, views):
     """Per-corner projection - observation (px, (N, 2), NaN where a point does not project) of
     every corner of the views the fit used, through the written sensor.yaml, the fitted poses
-    (calibration.json "poses") and the fitted board warp; and each row's view index."""
+    (calibration.json "poses") and the fitted board warp; per row its view index, observed
+    pixel and board point (mm)."""
     sensor = os.path.join(calibration["_dir"], "sensor.yaml")
-    residuals, view_of = [], []
+    residuals, view_of, observed, board_xy = [], [], [], []
     for index, view in enumerate(views):
         pose = calibration["poses"].get(view["image"])
         if pose is None:
@@ -299,6 +300,8 @@ def omnical_corner_residuals(omnical_cli, calibration, board, views):
         pixels = _project(omnical_cli, sensor, board_mm @ rotation.T + translation)
         residuals.append(pixels - view["pixels"])
         view_of += [index] * len(view["ids"])
+        observed.append(view["pixels"])
+        board_xy.append(board_mm[:, :2])
     if not residuals:
-        return np.zeros((0, 2)), np.zeros(0, dtype=int)
-    return np.concatenate(residuals), np.array(view_of)
+        return np.zeros((0, 2)), np.zeros(0, dtype=int), np.zeros((0, 2)), np.zeros((0, 2))
+    return np.concatenate(residuals), np.array(view_of), np.concatenate(observed), np.concatenate(board_xy)

@@ -1,22 +1,20 @@
 """Is anything left in a fit's residuals that a more flexible model could learn?
 
-Three measurements on per-corner residual vectors (projection - observation, px):
+Two measurements on per-corner residual vectors (projection - observation, px):
 
 - neighbour correlation: over pairs of corners of one view that are nearest neighbours
-  on the board, mean(e_a . e_b) / mean(|e|^2). A model error or a smooth board bend moves
-  neighbours alike (towards +1); independent corner errors give ~0; a model that fits
-  each view's noise pushes neighbours apart (below 0).
+  on the board, mean(e_a . e_b) / mean(|e|^2) (every corner, outliers too). A model error
+  or a smooth board bend moves neighbours alike (towards +1); independent corner errors
+  give ~0; a model that fits each view's noise pushes neighbours apart (below 0).
 - an image-plane correction field, learnt from the residuals of all views but one and
   applied to the one left out (every view in turn): what a flexible non-symmetric term (a
   figure error, lens decentering, a residual distortion) could add to a prediction. The
   field is bilinear on an n x n knot grid over the corners' bounding box, its values
   fitted by ridge least squares; the held-out RMS is over every view's corners after
-  their own field was subtracted. If no field beats none held out, the residuals hold no
-  structure that recurs across views.
-- degrees of freedom: with independent corner errors of one variance, a least-squares fit
-  of p parameters to n coordinates leaves E[sum e^2] = sigma^2 (n - p). From one fit's
-  RMS and parameter count, the RMS another fit with more parameters would reach by
-  fitting noise alone.
+  their own field was subtracted. The residuals come from one fit of every view, so the
+  left-out view's pose (and the intrinsics) saw it: a refit could absorb part of a field,
+  and part of what the field learns may be that view's own error. A field that does not
+  predict the left-out views says the residuals hold no structure recurring across views.
 
 Numbers only (numpy); the caller writes them into the document.
 """
@@ -32,20 +30,24 @@ def rms(residuals):
 
 def neighbour_correlation(residuals, view_of, board_xy_mm):
     """mean(e_a . e_b) / mean(|e|^2) over same-view pairs at the board's nearest-neighbour
-    distance (within 1 %)."""
+    distance (within 1 %), and the number of pairs."""
     points = np.asarray(board_xy_mm, dtype=float)
     residuals = np.asarray(residuals, dtype=float)
     view_of = np.asarray(view_of)
-    gaps = np.hypot(*(points[:, None, :] - points[None, :, :]).transpose(2, 0, 1))
-    same = view_of[:, None] == view_of[None, :]
-    positive = gaps[same & (gaps > 1e-9)]
-    if positive.size == 0:
+    views = [np.flatnonzero(view_of == v) for v in np.unique(view_of)]
+    gaps = [np.hypot(*(points[i][:, None, :] - points[i][None, :, :]).transpose(2, 0, 1)) for i in views]
+    positive = [g[g > 1e-9] for g in gaps]
+    if not any(p.size for p in positive):
         return float("nan"), 0
-    pairs = np.argwhere(np.triu(same & (gaps > 1e-9) & (gaps <= 1.01 * positive.min()), 1))
-    if len(pairs) == 0:
+    nearest = min(p.min() for p in positive if p.size)
+    dots = []
+    for rows, gap in zip(views, gaps):
+        a, b = np.nonzero(np.triu((gap > 1e-9) & (gap <= 1.01 * nearest), 1))
+        dots.append(np.sum(residuals[rows[a]] * residuals[rows[b]], axis=1))
+    dots = np.concatenate(dots)
+    if dots.size == 0:
         return float("nan"), 0
-    dots = np.sum(residuals[pairs[:, 0]] * residuals[pairs[:, 1]], axis=1)
-    return float(np.mean(dots) / np.mean(np.sum(residuals ** 2, axis=1))), int(len(pairs))
+    return float(np.mean(dots) / np.mean(np.sum(residuals ** 2, axis=1))), int(dots.size)
 
 
 def _hat(values, low, high, knots):
@@ -89,13 +91,3 @@ def correction_field(pixels, residuals, view_of, knot_grids=KNOT_GRIDS, ridges=R
     best = min(fields, key=lambda f: f["held_out_rms_px"])
     richest = min(fields, key=lambda f: f["train_rms_px"])
     return dict(none_rms_px=rms(residuals), best=best, richest=richest, fields=fields, views=int(len(views)))
-
-
-def noise_fit_rms(rms_px, corners, params, more_params):
-    """The RMS a fit with `more_params` parameters would reach on the same corners by fitting
-    independent noise alone, from a fit of `params` with RMS `rms_px` (2 coordinates each)."""
-    n = 2 * corners
-    if n <= more_params or n <= params:
-        return float("nan")
-    sigma2 = rms_px ** 2 * corners / ((n - params) / 2.0)  # per-corner variance, unbiased
-    return float(np.sqrt(sigma2 * (n - more_params) / n))
