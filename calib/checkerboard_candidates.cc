@@ -201,7 +201,7 @@ CheckedGrid CheckGridJunctions(const cv::Mat& grey, const CheckerGrid& grid, dou
     for (const int sign : {1, -1})
       if (is_good(r + sign * dr, c + sign * dc) && is_good(r + 2 * sign * dr, c + 2 * sign * dc))
         return sign * (working.at(r + 2 * sign * dr, c + 2 * sign * dc) - working.at(r + sign * dr, c + sign * dc));
-    std::vector<Eigen::Vector2d> line;  // no two neighbours passed: the found grid's own step
+    std::vector<Eigen::Vector2d> line;  // no two neighbours passed: the found grid's step (the corner's own too)
     for (int k = 0; k < (dr ? grid.rows : grid.cols); ++k) line.push_back(dr ? grid.at(k, c) : grid.at(r, k));
     return AlongStep(line, dr ? r : c);
   };
@@ -231,9 +231,14 @@ CheckedGrid CheckGridJunctions(const cv::Mat& grey, const CheckerGrid& grid, dou
       const Eigen::Vector2d start = point;
       if (!PullOntoJunction(grey, step_px, &point) || (point - start).norm() > tolerance_px(step_px)) return std::nullopt;
       const double agree_px = std::max(0.5, 0.03 * step_px);
+      const double margin_px = std::max(2, static_cast<int>(0.3 * step_px)) + 2.0;  // PullOntoJunction's
       for (const Eigen::Vector2d& along : {step_along(r, c, 0, 1), step_along(r, c, 1, 0)})
         for (const double sign : {1.0, -1.0}) {
           Eigen::Vector2d from = point + sign * 0.1 * step_px * along.normalized();
+          // A start too near the image's edge for cornerSubPix's window is no evidence.
+          if (from.x() < margin_px || from.y() < margin_px || from.x() > grey.cols - 1 - margin_px ||
+              from.y() > grey.rows - 1 - margin_px)
+            continue;
           if (!PullOntoJunction(grey, step_px, &from) || (from - point).norm() > agree_px) return std::nullopt;
         }
     }
@@ -242,11 +247,9 @@ CheckedGrid CheckGridJunctions(const cv::Mat& grey, const CheckerGrid& grid, dou
   };
   // Where the corner's neighbours that passed put it, pulled onto the image's junction:
   // one-sided (quadratic from three towards the board's inside) first, then midpoints of
-  // two on a line through it. An edge row or column the detector misplaced as a whole
-  // agrees with itself; the lines across it do not. nullopt: no prediction pulled.
-  enum class Verdict { kNone, kConfirms, kElsewhere };
-  // Every prediction's junction, in that order.
-  auto predicted_all = [&](int r, int c) {
+  // two on a line through it (an edge row or column the detector misplaced as a whole
+  // agrees with itself; the lines across it do not). The first that is a junction.
+  auto predicted = [&](int r, int c) -> std::optional<Eigen::Vector2d> {
     std::vector<Eigen::Vector2d> guesses;
     for (const bool one_sided : {true, false})
       for (const auto& [dr, dc] : {std::pair<int, int>{0, 1}, {1, 0}}) {
@@ -263,36 +266,23 @@ CheckedGrid CheckGridJunctions(const cv::Mat& grey, const CheckerGrid& grid, dou
         }
       }
     const double step_px = step_at(r, c);
-    std::vector<std::pair<Verdict, Eigen::Vector2d>> out;
-    for (Eigen::Vector2d guess : guesses) {
-      if (!PullOntoJunction(grey, step_px, &guess)) continue;
-      const std::optional<Eigen::Vector2d> junction = junction_at(guess, r, c);
-      if (!junction) continue;
-      out.push_back({(*junction - working.at(r, c)).norm() <= tolerance_px(step_px) ? Verdict::kConfirms
-                                                                                     : Verdict::kElsewhere,
-                     *junction});
-    }
-    return out;
-  };
-  auto predicted = [&](int r, int c, Eigen::Vector2d* where) {
-    const auto all = predicted_all(r, c);
-    if (all.empty()) return Verdict::kNone;
-    *where = all.front().second;
-    return all.front().first;
+    for (Eigen::Vector2d guess : guesses)
+      if (PullOntoJunction(grey, step_px, &guess))
+        if (const std::optional<Eigen::Vector2d> junction = junction_at(guess, r, c)) return junction;
+    return std::nullopt;
   };
   auto replace = [&](int r, int c, const Eigen::Vector2d& point) {
     working.corners_px[r * grid.cols + c] = point;
     replaced[r * grid.cols + c] = good[r * grid.cols + c] = true;
   };
 
-  // 1. Each corner on its own. Not testable (samples off the image): kept as found.
-  std::vector<bool> testable(count, true);
+  // 1. Each corner on its own (every other corner taken as found). Not testable (samples
+  // off the image): kept as found.
+  std::vector<bool> passed(count, true);
   for (int r = 0; r < grid.rows; ++r)
-    for (int c = 0; c < grid.cols; ++c) {
-      const int index = r * grid.cols + c;
-      testable[index] = !std::isnan(score_at(grid.at(r, c), r, c));
-      good[index] = !testable[index] || junction_at(grid.at(r, c), r, c).has_value();
-    }
+    for (int c = 0; c < grid.cols; ++c)
+      if (!std::isnan(score_at(grid.at(r, c), r, c))) passed[r * grid.cols + c] = junction_at(grid.at(r, c), r, c).has_value();
+  good = passed;
   // 2. The ones that failed, against their neighbours that passed (and those re-placed
   // before them): a corner that passes now (its steps were its own bad neighbours') stays;
   // else the junction a prediction pulls onto, or where cornerSubPix settles from the
@@ -305,9 +295,8 @@ CheckedGrid CheckGridJunctions(const cv::Mat& grey, const CheckerGrid& grid, dou
         good[index] = true;
         continue;
       }
-      Eigen::Vector2d where = grid.at(r, c);
-      if (predicted(r, c, &where) != Verdict::kNone) {
-        replace(r, c, where);
+      if (const std::optional<Eigen::Vector2d> where = predicted(r, c)) {
+        replace(r, c, *where);
         continue;
       }
       Eigen::Vector2d settled = grid.at(r, c);
@@ -318,20 +307,6 @@ CheckedGrid CheckGridJunctions(const cv::Mat& grey, const CheckerGrid& grid, dou
         }
       }
       dropped[index] = true;
-    }
-  // 3. Every other testable corner against its neighbours (steps >= kMinPullStepPx): a
-  // point on a square's edge past cornerSubPix's window can pass 1. It moves to the
-  // junction the first prediction pulls onto when no prediction pulls onto the corner.
-  for (int r = 0; r < grid.rows; ++r)
-    for (int c = 0; c < grid.cols; ++c) {
-      const int index = r * grid.cols + c;
-      if (!good[index] || replaced[index] || !testable[index] || step_at(r, c) < kMinPullStepPx) continue;
-      good[index] = false;  // not its own neighbour
-      const auto all = predicted_all(r, c);
-      good[index] = true;
-      bool confirmed = false;
-      for (const auto& prediction : all) confirmed = confirmed || prediction.first == Verdict::kConfirms;
-      if (!confirmed && !all.empty()) replace(r, c, all.front().second);
     }
   CheckedGrid out;
   out.corners_px = working.corners_px;

@@ -85,22 +85,22 @@ struct CheckerboardCandidate {
 
 // A found grid's corners checked against the image: findChessboardCornersSB can return
 // the outer corners of a strongly sheared board on a square's edge instead of its
-// junction (the realistic render's real001 near the rim: 2.4-12.9 px off). A corner is at
-// a junction where XJunctionScore exceeds `threshold` and, on grid steps of 20 px and more,
-// cornerSubPix started on it (PullOntoJunction) stays within max(1.5 px, 0.05 step). Steps
-// come from the corner's neighbours that passed, never from the corner itself, and the
-// step that sizes cornerSubPix's window is the distance to the nearest other junction (a
-// sheared grid's short diagonal too). Three passes:
-// 1. each corner on its own;
-// 2. one that failed: kept if it passes with its neighbours' steps, else put at the
-//    junction a prediction from its neighbours pulls onto (one-sided quadratic from three
-//    towards the board's inside first, then the midpoint of two on a line through it),
-//    else where cornerSubPix settles from it if that is a junction, else dropped;
-// 3. (steps of 20 px and more) one that passed moves where the first prediction that
-//    pulls onto a junction puts it, if that is farther than the tolerance: a point on an
-//    edge past cornerSubPix's window passes 1 (real001's 8.4 px corner).
-// Passes 2 and 3 go row by row, each using the corners as re-placed before it. A corner
-// that cannot be scored (its samples leave the image) is kept as found.
+// junction (the realistic render's real001 near the rim: 2.4-12.9 px off). A point is a
+// junction where XJunctionScore exceeds `threshold` and, on grid steps of 20 px and more,
+// cornerSubPix (PullOntoJunction) started on it settles within max(1.5 px, 0.05 step) and,
+// started a tenth of a step away along either grid line, comes back within max(0.5 px,
+// 0.03 step) (on a straight edge it only moves across the edge; a start too near the
+// image's edge is skipped); the score is then taken where it settled. Steps come from the
+// corner's neighbours that passed, not from the corner itself (where no two did: the found
+// grid's), and the step that sizes cornerSubPix's window is the distance to the nearest
+// other junction (a sheared grid's short diagonal too). Two passes:
+// 1. each corner on its own, the corner kept where found if it is a junction;
+// 2. row by row, one that failed: kept if it passes with the steps of its neighbours that
+//    passed (or were re-placed before it); else put at the first junction a prediction
+//    from them pulls onto (one-sided quadratic from three towards the board's inside
+//    first, then the midpoint of two on a line through it); else where cornerSubPix
+//    settles from it, if that is a junction; else dropped.
+// A corner that cannot be scored (its samples leave the image) is kept as found.
 struct CheckedGrid {
   std::vector<Eigen::Vector2d> corners_px;  // the grid's, re-placed ones moved
   std::vector<bool> kept;                   // per corner: false where dropped

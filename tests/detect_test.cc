@@ -517,11 +517,13 @@ cv::Mat DrawShearedChecker(int size_px, const Eigen::Vector2d& axis_a_px, const 
 // boards blurred 0.8 px like the render. 30 px squares: corners moved 8, 3 and 12 px along
 // their grid lines come back to their junctions; a corner whose squares do not meet as an
 // X (one ink square printed white: its four corners are L corners) is dropped; every other
-// corner is returned exactly as given. Sheared boards: one 8 px off on a board with 35 deg
-// between its axes (pass 1 moves it), one 8 px along its row that cornerSubPix started on
-// it does not move (only the neighbours' prediction, pass 3, finds it), and a whole first
-// column 10 px off on 60 px squares 20 deg apart, where cornerSubPix with a window sized
-// by the grid step (not the short diagonal) drifts 7-9 px even from a true junction.
+// corner is returned exactly as given. Sheared boards: on one with 35 deg between its axes
+// a corner 8 px along its column and one 8 px along its row (cornerSubPix started there
+// barely moves; started a tenth of a step away along the row it stays apart); and a whole
+// first column 10 px off on 60 px squares 20 deg apart, where cornerSubPix with a window
+// sized by the grid step (not the short diagonal) drifts 7-9 px even from a true junction.
+// And a board whose first column lies 0.38 of a step from the image's edge, where the
+// check's restarts would leave the image: every corner kept as it is.
 // 0.3 px: cornerSubPix's accuracy on a blurred antialiased junction (the drawing's own
 // corners are exact; measured 0.01-0.09 px), well under the 3-12 px being corrected; 0.5
 // px at 20 deg, whose acute wedges are ~4 px wide in cornerSubPix's window (measured 0.44).
@@ -612,6 +614,18 @@ TEST(CheckGridJunctions, PutsCornersOffTheirJunctionBackAndDropsOnesWithoutAJunc
   const CheckedGrid column = CheckGridJunctions(at_20, off, threshold);
   EXPECT_EQ(column.dropped, 0);
   expect_back(column, off, sheared, first_column, 0.5);  // measured up to 0.44 px: 20 deg wedges are thin
+
+  // Axis-aligned 30 px squares, the first column 11.4 px (0.38 step) from the left edge.
+  const Eigen::Vector2d near_edge(11.4 - kSquare, 40.0);
+  cv::Mat at_edge = DrawChecker(420, kSquare, 0.0, near_edge, [](int a, int b) {
+    return (a >= 0 && a < 9 && b >= 0 && b < 7) ? ((a + b) % 2 ? kPaper : kInk) : kPaper;
+  });
+  cv::GaussianBlur(at_edge, at_edge, cv::Size(0, 0), 0.8);
+  const CheckerGrid edge_truth = TrueGrid(kSquare, 0.0, near_edge);
+  ASSERT_NEAR(edge_truth.at(0, 0).x(), 11.4, 1e-9);
+  const CheckedGrid by_edge = CheckGridJunctions(at_edge, edge_truth, threshold);
+  EXPECT_EQ(by_edge.dropped, 0);
+  EXPECT_EQ(by_edge.replaced, 0);
 }
 
 // The realistic render's real001 (a board near the rim whose axes meet at 32-61 deg along
