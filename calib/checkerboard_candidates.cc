@@ -281,7 +281,8 @@ CheckedGrid CheckGridJunctions(const cv::Mat& grey, const CheckerGrid& grid, dou
   std::vector<bool> passed(count, true);
   for (int r = 0; r < grid.rows; ++r)
     for (int c = 0; c < grid.cols; ++c)
-      if (!std::isnan(score_at(grid.at(r, c), r, c))) passed[r * grid.cols + c] = junction_at(grid.at(r, c), r, c).has_value();
+      if (!std::isnan(score_at(grid.at(r, c), r, c)))
+        passed[r * grid.cols + c] = junction_at(grid.at(r, c), r, c).has_value();
   good = passed;
   // 2. The ones that failed, against their neighbours that passed (and those re-placed
   // before them): a corner that passes now (its steps were its own bad neighbours') stays;
