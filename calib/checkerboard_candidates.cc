@@ -192,7 +192,9 @@ CheckedGrid CheckGridJunctions(const cv::Mat& grey, const CheckerGrid& grid, dou
   const int count = grid.rows * grid.cols;
   CheckerGrid working = grid;  // the corners as re-placed so far
   std::vector<bool> good(count, true), replaced(count, false), dropped(count, false);
-  auto is_good = [&](int r, int c) { return r >= 0 && c >= 0 && r < grid.rows && c < grid.cols && good[r * grid.cols + c]; };
+  auto is_good = [&](int r, int c) {
+    return r >= 0 && c >= 0 && r < grid.rows && c < grid.cols && good[r * grid.cols + c];
+  };
   // The grid step through (r, c) along (dr, dc) from its neighbours that passed, never from
   // the corner itself (an end corner off its junction would shorten its own step).
   auto step_along = [&](int r, int c, int dr, int dc) -> Eigen::Vector2d {
@@ -229,7 +231,8 @@ CheckedGrid CheckGridJunctions(const cv::Mat& grey, const CheckerGrid& grid, dou
     const double step_px = step_at(r, c);
     if (step_px >= kMinPullStepPx) {
       const Eigen::Vector2d start = point;
-      if (!PullOntoJunction(grey, step_px, &point) || (point - start).norm() > tolerance_px(step_px)) return std::nullopt;
+      if (!PullOntoJunction(grey, step_px, &point) || (point - start).norm() > tolerance_px(step_px))
+        return std::nullopt;
       const double agree_px = std::max(0.5, 0.03 * step_px);
       const double margin_px = std::max(2, static_cast<int>(0.3 * step_px)) + 2.0;  // PullOntoJunction's
       for (const Eigen::Vector2d& along : {step_along(r, c, 0, 1), step_along(r, c, 1, 0)})
