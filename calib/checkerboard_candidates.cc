@@ -173,14 +173,21 @@ void MaskGrid(const CheckerGrid& grid, cv::Mat* image) {
   image->setTo(cv::mean(*image, mask), mask);
 }
 
+// PullOntoJunction's cornerSubPix window: half its side, and whether it fits in the image
+// around `start`.
+int PullHalfWindow(double step_px) { return std::max(2, static_cast<int>(0.3 * step_px)); }
+bool PullWindowFits(const cv::Mat& grey, double step_px, const Eigen::Vector2d& start) {
+  const int half_window = PullHalfWindow(step_px);
+  return start.x() >= half_window + 1 && start.y() >= half_window + 1 && start.x() < grey.cols - half_window - 2 &&
+         start.y() < grey.rows - half_window - 2;
+}
+
 }  // namespace
 
 bool PullOntoJunction(const cv::Mat& grey, double step_px, Eigen::Vector2d* point) {
-  const int half_window = std::max(2, static_cast<int>(0.3 * step_px));
+  const int half_window = PullHalfWindow(step_px);
   const Eigen::Vector2d start = *point;
-  if (!(start.x() >= half_window + 1 && start.y() >= half_window + 1 && start.x() < grey.cols - half_window - 2 &&
-        start.y() < grey.rows - half_window - 2))
-    return false;
+  if (!PullWindowFits(grey, step_px, start)) return false;
   std::vector<cv::Point2f> refined{cv::Point2f(static_cast<float>(start.x()), static_cast<float>(start.y()))};
   cv::cornerSubPix(grey, refined, cv::Size(half_window, half_window), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 20, 0.05));
@@ -234,14 +241,11 @@ CheckedGrid CheckGridJunctions(const cv::Mat& grey, const CheckerGrid& grid, dou
       if (!PullOntoJunction(grey, step_px, &point) || (point - start).norm() > tolerance_px(step_px))
         return std::nullopt;
       const double agree_px = std::max(0.5, 0.03 * step_px);
-      const double margin_px = std::max(2, static_cast<int>(0.3 * step_px)) + 2.0;  // PullOntoJunction's
       for (const Eigen::Vector2d& along : {step_along(r, c, 0, 1), step_along(r, c, 1, 0)})
         for (const double sign : {1.0, -1.0}) {
           Eigen::Vector2d from = point + sign * 0.1 * step_px * along.normalized();
           // A start too near the image's edge for cornerSubPix's window is no evidence.
-          if (from.x() < margin_px || from.y() < margin_px || from.x() > grey.cols - 1 - margin_px ||
-              from.y() > grey.rows - 1 - margin_px)
-            continue;
+          if (!PullWindowFits(grey, step_px, from)) continue;
           if (!PullOntoJunction(grey, step_px, &from) || (from - point).norm() > agree_px) return std::nullopt;
         }
     }

@@ -20,13 +20,14 @@ import numpy as np
 
 import omnical
 
+sys.dont_write_bytecode = True  # no __pycache__ beside the sources
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from omnical_runs import write_detections  # noqa: E402
+
 
 def fit(target, data, indices, scratch):
-    subset = dict(data)
-    subset["images"] = [data["images"][i] for i in indices]
     path = os.path.join(scratch, "half.json")
-    with open(path, "w") as handle:
-        json.dump(subset, handle)
+    write_detections(data, {data["images"][i]["image"] for i in indices}, path)
     return omnical.calibrate(target, detections=omnical.Detections.load(path), board_warp=True)
 
 
