@@ -113,9 +113,9 @@ BoardScale CheckBoardScale(const Sensor& sensor, const CalibrationTarget& target
   result.best_distance_mm = best.distance_mm;
   result.rms_at_target_px = std::sqrt(at_target.sum_px2 / corners.size());
   result.rms_at_best_px = std::sqrt(best.sum_px2 / corners.size());
-  const double chi2 = (at_target.sum_px2 - best.sum_px2) / (sigma_px * sigma_px);
+  result.chi2_gain = (at_target.sum_px2 - best.sum_px2) / (sigma_px * sigma_px);
   const bool other_size = best.scale > options.max_size_ratio || best.scale < 1.0 / options.max_size_ratio;
-  if (other_size && chi2 > options.min_chi2) {
+  if (other_size && result.chi2_gain > options.min_chi2) {
     result.refused = true;
     char text[240];
     std::snprintf(text, sizeof text,

@@ -38,6 +38,7 @@ struct BoardScale {
   double rms_at_target_px = 0.0;    // per corner, pose refitted at the target's size
   double rms_at_best_px = 0.0;
   double best_distance_mm = 0.0;    // the best-sized board's distance from the lens
+  double chi2_gain = 0.0;           // how much better the best size fits, in units of the corner variance
   bool refused = false;
   std::string reason;               // why refused: "fits as a board 4.0 x its size at 880 mm (...)"
 };

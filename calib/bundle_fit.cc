@@ -85,6 +85,17 @@ double RobustSigma(std::vector<double> norms) {
   return norms[norms.size() / 2] / 1.1774;
 }
 
+// The sigma per coordinate of the residuals' bulk: sqrt(mean |e|^2 / 2) over the norms
+// within bulk_sigmas x RobustSigma (FitOptions::outlier_bulk_sigmas says why).
+double BulkSigma(const std::vector<double>& norms, double bulk_sigmas) {
+  const double limit = bulk_sigmas * RobustSigma(norms);
+  double square_sum = 0.0;
+  int count = 0;
+  for (double n : norms)
+    if (n <= limit) square_sum += n * n, ++count;
+  return count > 0 ? std::sqrt(square_sum / (2.0 * count)) : 1.0;
+}
+
 // One fit of one model type: the problem, its stages, and the result it fills.
 template <typename Model>
 class FitRun {
@@ -373,12 +384,13 @@ class FitRun {
     Solve(Precision::kStart);
   }
 
-  // Gross outliers (robust mode): beyond max(floor, k sigma) of a robust sigma, removed,
+  // Gross outliers (robust mode): beyond max(floor, k sigma) of the bulk's sigma, removed,
   // then views that fit far worse than the others, and the fit repeated without them under
   // Huber. False when too few views are left.
   bool RejectOutliersAndRefit() {
     const std::vector<double> norms = ResidualNorms();
-    const double threshold = std::max(options_.outlier_floor_px, options_.outlier_sigmas * RobustSigma(norms));
+    const double threshold =
+        std::max(options_.outlier_floor_px, options_.outlier_sigmas * BulkSigma(norms, options_.outlier_bulk_sigmas));
     result_.outlier_threshold_px = threshold;
     std::vector<size_t> view_inliers(views_, 0);
     for (size_t k = 0; k < residuals_.size(); ++k) {

@@ -9,14 +9,13 @@
 #include <optional>
 #include <utility>
 
-#include "calib/board_scale.h"
+#include "calib/board_size_screen.h"
 #include "calib/cross_validation.h"
 #include "calib/fit_covariance.h"
 #include "calib/image_file.h"
 #include "calib/rim_circle.h"
 #include "model/input_error.h"
 #include "model/model_registry.h"
-#include "model/parallel_rows.h"
 
 namespace omnical {
 namespace {
@@ -358,26 +357,20 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   }
   Sensor fit_start = refit_start ? *refit_start : guess;
   // Boards of another size than the target (a decoy the detector accepted, e.g. a window
-  // of tiles that passed the continuation test) are refused through the fitted sensor and
-  // the fit is repeated without them (calib/board_scale.h).
+  // of tiles that passed the continuation test) are refused through the fitted sensor (a
+  // suspect through a fit without it) and the fit is repeated without them
+  // (calib/board_size_screen.h).
   // Only through a design: from the rim circle alone the sensor's scale is a gauge and its
   // mirror family an approximation, and boards fit a little better at other sizes (on
   // rendered/ohte-sph-misaligned-near 3-4 of 8 true boards were refused that way).
   if (fit.sensor && input.guess) {
-    std::vector<BoardScale> checks(views.detections.images.size());
-    // Four small fits per view, independent: a third of `calibrate --detections` on the
-    // rendered misaligned set when run one after another.
-    ParallelRows(static_cast<int>(checks.size()), options.threads, [&](int v) {
-      if (fit.view_left_out[v].empty())
-        checks[v] = CheckBoardScale(*fit.sensor, input.target, views.detections.images[v], fit.poses[v], fit.sigma_px,
-                                    BoardScaleOptions(), fit.board_warp ? fit.board_warp->warp : fit_options.board_warp);
-    });
-    std::vector<size_t> refused;
-    for (size_t v = 0; v < checks.size(); ++v) {
-      if (!checks[v].refused) continue;
-      record.views_left_out[views.detections.images[v].image] = "the board " + checks[v].reason;
-      refused.push_back(v);
-    }
+    BoardSizeScreenOptions screen_options;
+    screen_options.threads = options.threads;
+    const BoardSizeScreen screen =
+        ScreenBoardSizes(fit_start, input.target, views.detections, fit, fit_options, screen_options);
+    const std::vector<size_t>& refused = screen.refused;
+    for (size_t v : refused)
+      record.views_left_out[views.detections.images[v].image] = "the board " + screen.checks[v].reason;
     for (auto v = refused.rbegin(); v != refused.rend(); ++v) {
       views.observations -= static_cast<int>(views.detections.images[*v].corners.size());
       views.detections.images.erase(views.detections.images.begin() + *v);

@@ -123,8 +123,10 @@ FitOptions FitOptions::DefaultsFor(const Sensor& sensor) {
 
 std::string FitOptions::Check() const {
   if (!(robust_loss_px >= 0.0)) return "robust_loss_px: must be >= 0";
-  if (!(outlier_floor_px >= 0.0) || !(outlier_sigmas > 0.0) || !(view_rms_ratio > 1.0))
-    return "outlier rule: outlier_floor_px >= 0, outlier_sigmas > 0 and view_rms_ratio > 1";
+  if (!(outlier_floor_px >= 0.0) || !(outlier_sigmas > 0.0) || !(outlier_bulk_sigmas >= outlier_sigmas) ||
+      !(view_rms_ratio > 1.0))
+    return "outlier rule: outlier_floor_px >= 0, outlier_sigmas > 0, outlier_bulk_sigmas >= outlier_sigmas and "
+           "view_rms_ratio > 1";
   if (solver.max_num_iterations < 1) return "max_iterations: must be >= 1";
   if (threads < 1) return "threads: must be >= 1";
   // The threads work through an evaluation callback, which Ceres refuses with inner iterations.

@@ -76,22 +76,24 @@ TEST(RealImages, MeiParabolicDetectsAndCalibrates) {
     if (auto circle = DetectRimCircle(cv::imread(kData + "/" + image.image, cv::IMREAD_GRAYSCALE))) circles.push_back(*circle);
   ASSERT_EQ(circles.size(), 10u);
   const RimCircle rim = *MedianRimCircle(circles);
-  for (const auto& [profile, rms_bound] : std::vector<std::pair<std::string, double>>{{"polynomial", 0.45}, {"paraboloid", 1.2}}) {
+  for (const auto& [profile, rms_bound] : std::vector<std::pair<std::string, double>>{{"polynomial", 0.45}, {"paraboloid", 1.3}}) {
     const Sensor guess = SensorFromRimCircle(rim, detections.image_width_px, detections.image_height_px, profile);
     std::vector<TargetPose> poses(detections.images.size());
     for (size_t v = 0; v < poses.size(); ++v) ASSERT_TRUE(InitialTargetPose(guess, board, detections.images[v], &poses[v])) << v;
     const FitResult fit = FitSensor(guess, board, detections, poses, FitOptions::DefaultsFor(guess));
     EXPECT_TRUE(fit.converged) << fit.solver_report;
     EXPECT_EQ(fit.dropped, 0);
-    // Measured: polynomial 0.321 px over all 10 views (15 of 480 corners cut), paraboloid
-    // 0.92 px (an ideal paraboloid cannot bend as the real mirror does).
+    // Measured: polynomial 0.365 px over all 10 views (1 of 480 corners cut), paraboloid
+    // 1.21 px (an ideal paraboloid cannot bend as the real mirror does: its misfit is the
+    // bulk of the residuals, and the outlier rule's sigma counts it).
     EXPECT_LT(fit.rms_px, rms_bound) << profile;
-    // Every view stays in the fit (the trust issue). The outlier rule (4 robust sigma,
-    // floor 0.5 px) cuts the polynomial's tail: measured 15 of 480 (3.1 %) beyond 0.84 px.
-    // The paraboloid's 63 beyond 2.4 px are its misfit, not bad corners (not bounded).
+    // Every view stays in the fit (the trust issue). The outlier rule (5 sigma of the
+    // bulk, floor 0.5 px) cuts the polynomial's tail: measured 1 of 480 beyond 1.29 px (the
+    // previous rule, 4 median sigma: 15, 3.1 %, beyond 0.84 px). The paraboloid's 37 beyond
+    // 4.35 px are its misfit, not bad corners (not bounded).
     for (size_t v = 0; v < fit.view_left_out.size(); ++v) EXPECT_EQ(fit.view_left_out[v], "") << profile << " view " << v;
     if (profile == "polynomial") {
-      EXPECT_LT(fit.outliers, 0.04 * 480);
+      EXPECT_LE(fit.outliers, 0.01 * 480);  // the issue's bound: at most 1 % cut
       // Real boards are the target's size: none is refused as another board.
       for (size_t v = 0; v < detections.images.size(); ++v) {
         const BoardScale check = CheckBoardScale(*fit.sensor, board, detections.images[v], fit.poses[v], fit.sigma_px);

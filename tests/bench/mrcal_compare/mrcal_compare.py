@@ -50,7 +50,8 @@ DEFINITIONS = [
     "*per coordinate* (two measurements per corner), outliers and unobserved grid points counted as zeros, the "
     "regularization terms included. It is not comparable with the RMS columns: about RMS / √2 on a clean fit, "
     "lower still with padding (the aprilgrid's 76 x 76 grid makes it tiny).",
-    "- **Outliers**: omnical cuts corners beyond 4σ of a median-based σ ([calibrate](calibrate.md)); mrcal's "
+    "- **Outliers**: omnical cuts corners beyond 5σ of the σ of the residuals' bulk (those within 8 median-based "
+    "σ; [calibrate](calibrate.md)); mrcal's "
     "default rejection (`markOutliers` in mrcal.c) re-solves while any coordinate residual exceeds 5σ of the "
     "inliers' per-coordinate σ, cutting everything beyond 4σ each time. mrcal's `Noutliers` also counts the "
     "grid points without a corner; the column counts only observed corners it cut.",
