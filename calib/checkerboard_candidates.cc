@@ -226,7 +226,7 @@ CheckedGrid CheckGridJunctions(const cv::Mat& grey, const CheckerGrid& grid, dou
   // cornerSubPix started on a corner of the detector's settles within this of it (renders:
   // 0.1-0.9 px); started on a square's edge it travels 2.5-10 px. On steps under
   // kMinPullStepPx its window holds too few pixels to judge the detector by: on the real
-  // Mei images (9-15 px squares) it moved two corners that fitted at 0.2 px by 1.5-2 px.
+  // Mei images (steps 8-36 px) it moved two small-square corners that fitted at 0.2 px by 1.5-2 px.
   auto tolerance_px = [](double step_px) { return std::max(1.5, 0.05 * step_px); };
   constexpr double kMinPullStepPx = 20.0;
   // A junction at `point` for corner (r, c): X-shaped there and, on steps >= kMinPullStepPx,

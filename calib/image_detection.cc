@@ -23,6 +23,21 @@ struct OneImage {
   std::vector<std::string> refusals;  // checkerboard candidates refused
 };
 
+// The guess when the image has its size, else none.
+const Sensor* GuessFor(const cv::Mat& grey, const DetectionOptions& options) {
+  return options.guess && grey.cols == options.guess->image_width_px() && grey.rows == options.guess->image_height_px()
+             ? &*options.guess
+             : nullptr;
+}
+
+ImageDetections Refined(const CalibrationTarget& target, const cv::Mat& grey, const Sensor* guess,
+                        const DetectionOptions& options, const ImageDetections& found) {
+  const bool checkerboard = target.type() == CalibrationTarget::Type::kCheckerboard;
+  if (!options.refine && !(checkerboard && options.refine_checkerboards)) return found;
+  return RefineCorners(target, grey, guess, found, nullptr,
+                       checkerboard && !options.refine_checkerboards ? kMinRefinedCheckerStepPx : 0.0);
+}
+
 void DetectOne(const CalibrationTarget& target, const cv::Mat& grey, const DetectionOptions& options, OneImage* out) {
   if (grey.empty()) {
     out->problem = "cannot read the image";
@@ -30,10 +45,7 @@ void DetectOne(const CalibrationTarget& target, const cv::Mat& grey, const Detec
   }
   out->size = grey.size();
   const bool checkerboard = target.type() == CalibrationTarget::Type::kCheckerboard;
-  const Sensor* guess = options.guess && grey.cols == options.guess->image_width_px() &&
-                                grey.rows == options.guess->image_height_px()
-                            ? &*options.guess
-                            : nullptr;
+  const Sensor* guess = GuessFor(grey, options);
   const bool omni_search = options.omni_search || !guess;
   if (omni_search && checkerboard) {
     std::vector<CheckerboardCandidate> candidates;
@@ -44,8 +56,7 @@ void DetectOne(const CalibrationTarget& target, const cv::Mat& grey, const Detec
     out->found = DetectTarget(target, grey);
   }
   if (guess) out->found = DetectThroughVirtualViews(target, grey, *guess, out->found);
-  if (checkerboard ? options.refine_checkerboards : options.refine)
-    out->found = RefineCorners(target, grey, guess, out->found);
+  out->found = Refined(target, grey, guess, options, out->found);
   if (options.rim_circles) out->circle = DetectRimCircle(grey);
 }
 
@@ -109,6 +120,30 @@ DetectedImages DetectImageFiles(const CalibrationTarget& target, const std::vect
   return DetectAll(
       target, paths.size(), [&](size_t i) { return ReadImageFile(paths[i], cv::IMREAD_GRAYSCALE); },
       [&](size_t i) { return paths[i]; }, source, options);
+}
+
+DetectionSet RefineFoundCorners(const CalibrationTarget& target, const DetectionSet& found,
+                                const std::function<cv::Mat(const std::string&)>& image_of,
+                                const DetectionOptions& options) {
+  if (const std::string why = options.Check(); !why.empty()) throw InputError(why);
+  DetectionSet out = found;
+  const size_t count = found.images.size();
+  std::atomic<size_t> next{0};
+  ProgressReporter progress(options.progress, "refine", static_cast<long>(count));
+  auto work = [&]() {
+    for (size_t i = next++; i < count; i = next++) {
+      const cv::Mat grey = image_of(found.images[i].image);
+      if (!grey.empty() && grey.type() == CV_8UC1)
+        out.images[i] = Refined(target, grey, GuessFor(grey, options), options, found.images[i]);
+      if (!progress.Advance()) return;
+    }
+  };
+  std::vector<std::thread> pool;
+  StartWorkers(std::min<int>(options.threads, static_cast<int>(count)), work, &pool);
+  work();
+  for (std::thread& t : pool) t.join();
+  progress.ThrowIfCancelled();
+  return out;
 }
 
 DetectedImages DetectImages(const CalibrationTarget& target, const std::vector<NamedImage>& images,

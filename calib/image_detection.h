@@ -6,6 +6,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,8 +22,12 @@ namespace omnical {
 
 struct DetectionOptions {
   std::optional<Sensor> guess;        // virtual views (calib/detect.h) and patch refinement through it
-  bool refine = true;                 // aprilgrid corners (calib/refine_corners.h)
-  bool refine_checkerboards = false;  // see calib/refine_corners.h: better on renders, worse on real images
+  // Sub-pixel refinement (calib/refine_corners.h): aprilgrid corners, and checkerboard
+  // corners on grid steps of kMinRefinedCheckerStepPx and more.
+  bool refine = true;
+  // Every checkerboard corner, small squares too (on the real Mei images it made the
+  // halves of the set differ more: calib/refine_corners.h).
+  bool refine_checkerboards = false;
   bool rim_circles = false;
   // false: with a guess, search its virtual views only (images the omni image's search
   // already missed: a second pass through a fitted sensor).
@@ -43,6 +48,16 @@ struct NamedImage {
   std::string name;
   cv::Mat grey;  // 8-bit, one channel
 };
+
+// Corners found earlier without refinement (options.refine off) refined in their images
+// (calib/refine_corners.h) through options.guess, as DetectOne would have: a calibration
+// refines its checkerboard corners through its first fit, not through the design guess
+// (there, at large radii, patches through a misaligned guess moved corners OpenCV had to
+// 0.01-0.08 px by 0.1-0.7 px). image_of(name) gives an entry's pixels (8-bit grey; empty:
+// the entry is kept as it is). Parallel on options.threads, progress stage "refine".
+DetectionSet RefineFoundCorners(const CalibrationTarget& target, const DetectionSet& found,
+                                const std::function<cv::Mat(const std::string&)>& image_of,
+                                const DetectionOptions& options);
 
 // Throws InputError naming `source` (the directory or pattern) if no image could be read.
 DetectedImages DetectImageFiles(const CalibrationTarget& target, const std::vector<std::string>& paths,

@@ -168,7 +168,8 @@ double ReachOf(const CalibrationTarget& target) {
 }  // namespace
 
 ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& grey, const Sensor* guess,
-                              const ImageDetections& detections, CornerRefinementStats* stats) {
+                              const ImageDetections& detections, CornerRefinementStats* stats,
+                              double min_checker_step_px) {
   CornerRefinementStats local;
   std::map<int, Eigen::Vector2d> by_id;
   for (const CornerObservation& c : detections.corners) by_id[c.id] = c.pixel;
@@ -190,7 +191,12 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
     const std::vector<int> neighbour_ids = NeighboursOf(target, corner.id);
     bool moved = false;
     Eigen::Vector2d refined;
-    if (!guess) {
+    double omni_step_px = HUGE_VAL;
+    for (int n : neighbour_ids)
+      if (by_id.count(n)) omni_step_px = std::min(omni_step_px, (by_id[n] - corner.pixel).norm());
+    if (target.type() == CalibrationTarget::Type::kCheckerboard && !(omni_step_px >= min_checker_step_px)) {
+      // kept as detected (below)
+    } else if (!guess) {
       std::vector<Eigen::Vector2d> neighbours;
       for (int n : neighbour_ids)
         if (by_id.count(n)) neighbours.push_back(by_id[n]);

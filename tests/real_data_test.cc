@@ -14,7 +14,9 @@
 
 #include "calib/board_scale.h"
 #include "calib/bundle_fit.h"
+#include "calib/calibrate.h"
 #include "calib/detect.h"
+#include "calib/image_file.h"
 #include "calib/initial_sensor.h"
 #include "calib/rim_circle.h"
 #include "test_sensors.h"
@@ -107,6 +109,48 @@ TEST(RealImages, MeiParabolicDetectsAndCalibrates) {
     }
     RecordProperty(profile + "_rms_px", std::to_string(fit.rms_px));
   }
+}
+
+// The issue's bounds on the real dev set, calibrated as a user would (`omnical calibrate
+// --images ... --board-warp --cross-validate`, then `--holdout 2`), from the images alone:
+// at most 1 % of the corners cut, the two halves within 0.35 px of each other at 2 m, and
+// the held-out views' RMS within 25 % of the training views'. Measured: 3 cut (0.6 %),
+// halves 0.267 px, held out 0.368 against 0.320 px (1.15); with the checkerboard corners
+// as OpenCV found them 4 cut, 0.317 px, 1.30; with every corner refined (small squares
+// too) 1 cut, 0.347 px, 1.24. All-corner RMS 0.326 px (per corner; bounded here at 0.35
+// to catch a regression: mrcal's 10-knot spline fits the same corners at ~0.29,
+// docs/calibration-vs-mrcal.md).
+TEST(RealImages, MeiParabolicGeneralisesWithinTheIssuesBounds) {
+  if (!std::filesystem::exists(kData)) GTEST_SKIP() << kData << " is absent: the real-image test is skipped";
+  CalibrationInput input;
+  input.target_name = testing::SourceDir() + "/tests/data/mei-parabolic-checkerboard.yaml";
+  input.target = CalibrationTarget::FromYaml(input.target_name);
+  input.image_paths = ListImages(kData);
+  input.source = kData;
+  CalibrationOptions options;
+  options.board_warp = true;
+  options.cross_validate = true;
+  options.threads = 2;
+  const CalibrationResult full = Calibrate(input, options);
+  const CalibrationRecord& record = full.record;
+  EXPECT_EQ(record.views_left_out.size(), 0u);
+  EXPECT_EQ(record.observations, 480);
+  EXPECT_LE(record.outliers, 0.01 * record.observations);
+  EXPECT_LT(record.rms_all_px, 0.35);
+  ASSERT_TRUE(record.cross_validation);
+  EXPECT_DOUBLE_EQ(record.cross_validation->diff.distance_mm, 2000.0);
+  EXPECT_LE(record.cross_validation->diff.rms_px, 0.35);
+
+  options.cross_validate = false;
+  options.holdout_views = 2;
+  const CalibrationRecord held = Calibrate(input, options).record;
+  ASSERT_TRUE(held.holdout);
+  EXPECT_EQ(held.holdout->corners, 96);
+  EXPECT_LE(held.holdout->rms_px, 1.25 * held.rms_all_px)
+      << "held out " << held.holdout->rms_px << " px, training " << held.rms_all_px << " px";
+  std::printf("all-corner RMS %.3f px, %d cut, halves %.3f px at 2 m; held out %.3f px vs training %.3f px\n",
+              record.rms_all_px, record.outliers, record.cross_validation->diff.rms_px, held.holdout->rms_px,
+              held.rms_all_px);
 }
 
 }  // namespace

@@ -28,10 +28,12 @@ Command DetectCommand() {
             sub.add_option("--images", *images, "Directory of images, or a glob pattern (quote it)")->required();
             sub.add_option("--out", *out, "Detections file (JSON)")->required();
             auto no_refine = std::make_shared<bool>(false);
-            sub.add_flag("--no-refine", *no_refine, "Keep AprilTag's corners (no edge-profile refinement)");
+            sub.add_flag("--no-refine", *no_refine,
+                         "Keep the detectors' corners (no refinement of aprilgrid corners, nor of checkerboard corners "
+                         "on grid steps of 20 px and more)");
             sub.add_flag("--refine-checkerboard", options->refine_checkerboards,
-                         "Also refine checkerboard corners with cornerSubPix (sharper on clean images; on the real "
-                         "Mei images OpenCV's own corners fit better)");
+                         "Refine every checkerboard corner with cornerSubPix, on squares under 20 px too (sharper on "
+                         "clean images; on the real Mei images the set's halves then differ more)");
             sub.add_option("--threads", options->threads, "Worker threads")->check(CLI::Range(1, 256))->capture_default_str();
             return [=, &context]() {
               const CalibrationTarget target = CalibrationTarget::FromYaml(*spec);

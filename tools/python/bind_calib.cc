@@ -592,7 +592,8 @@ target: a Target or the path of a target spec. images: a directory or glob patte
 (as --images), a list of paths, a list of uint8 arrays (grey, BGR or BGRA; named by
 index) or a dict name -> array. guess: a Sensor or a sensor file; aprilgrid tags are
 then re-detected in virtual views and refined through it. refine: sub-pixel refinement
-of aprilgrid corners; refine_checkerboards: also of checkerboard corners. rim_circles:
+of aprilgrid corners and of checkerboard corners on grid steps of 20 px and more;
+refine_checkerboards: of every checkerboard corner, small squares too. rim_circles:
 also find each image's mirror rim. threads: 0 for all cores. progress(stage, done,
 total): return False to cancel. Unreadable images are skipped with a warning; raises
 InputError if none could be read.)");
