@@ -27,8 +27,11 @@ struct BoardScaleOptions {
   // True boards, through a fit their own noise (and a decoy's pull) bends, have been seen
   // to fit best at 0.70 x their size (a ratio of 1.43; tests/calibration_trust_test.cc,
   // a 4x giant in the set) and at 0.66 x (1.52: the realistic render's bent board at the
-  // inner radius, inner1); the distant giants 4 and 10 times the size at 1.79 and 2.01 x.
-  // No decoy smaller than the board has been measured.
+  // inner radius, inner1); the distant giants 4 and 10 times the size at 1.56 and 1.74 x
+  // through the fit they were in (1.79 and 2.01 x while the outlier rule cut more of their
+  // corners), which is why a suspect is checked again through a fit without it
+  // (calib/board_size_screen.h: the 4x giant then at 3.87 x). No decoy smaller than the
+  // board has been measured.
   double max_size_ratio = 1.65;
   double min_chi2 = 25.0;
 };

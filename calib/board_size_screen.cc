@@ -27,18 +27,18 @@ BoardSizeScreen ScreenBoardSizes(const Sensor& start, const CalibrationTarget& t
       screen.checks[v] = CheckBoardScale(*fit.sensor, target, detections.images[v], fit.poses[v], fit.sigma_px,
                                          options.scale, WarpOf(fit, fit_options));
   });
-  double farthest = std::log(options.suspect_ratio);
+  double strongest = options.scale.min_chi2;
   for (size_t v = 0; v < views; ++v) {
     const BoardScale& check = screen.checks[v];
     if (check.refused) {
       screen.refused.push_back(v);
-      continue;
+    } else if (fit.view_left_out[v].empty() && std::abs(std::log(check.best_scale)) > std::log(options.suspect_ratio) &&
+               check.chi2_gain > strongest) {
+      strongest = check.chi2_gain;
+      screen.suspect = static_cast<int>(v);
     }
-    if (std::abs(std::log(check.best_scale)) > farthest && check.chi2_gain > options.scale.min_chi2 &&
-        fit.view_left_out[v].empty())
-      farthest = std::abs(std::log(check.best_scale)), screen.suspect = static_cast<int>(v);
   }
-  if (!screen.refused.empty()) screen.suspect = -1;  // the refit without the refused ones follows
+  if (!screen.refused.empty()) screen.suspect = -1;  // the caller refits without them and screens again
   if (screen.suspect < 0) return screen;
   const size_t suspect = static_cast<size_t>(screen.suspect);
   DetectionSet others = detections;

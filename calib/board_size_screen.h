@@ -1,8 +1,12 @@
 // Which of a fit's views show a board of another size than the target (calib/board_scale.h),
-// each view checked through the fitted sensor, and a suspect once more through a sensor fitted
-// without it: a decoy bends the sensor it is checked through towards its own size. Measured: a
-// distant giant 4 x the board, one of 12 views, fit best at 1.56 x its size through the fit it
-// was in (under the 1.65 refusal ratio), and far beyond through the fit without it.
+// each view checked through the fitted sensor, and, when none is refused that way, the
+// strongest suspect once more through a sensor fitted without it: a decoy bends the sensor
+// it is checked through towards its own size. Measured: a distant giant 4 x the board, one
+// of 12 views, fit best at 1.56 x its size through the fit it was in (under the 1.65
+// refusal ratio), at 3.87 x through the fit without it. Only the strongest: a true board
+// checked through a fit without it but with the giant still in fit best at 0.60 x and was
+// refused. After a refusal the caller refits without the refused views and screens again
+// (calib/calibrate.cc), so decoys go one by one, the strongest first.
 #pragma once
 
 #include <vector>
@@ -19,8 +23,10 @@ namespace omnical {
 struct BoardSizeScreenOptions {
   BoardScaleOptions scale;
   // A view not refused whose best size lies beyond this ratio (either way) and fits better
-  // there by more than scale.min_chi2 is a suspect; the farthest one is checked again
-  // through a fit without it. True boards have fitted best at 0.66-1.43 x (1.52 as a ratio).
+  // there by more than scale.min_chi2 is a suspect; the one whose best size fits better by
+  // the most (chi2_gain) is checked again. Not the one farthest in size: true boards have
+  // fitted best at 0.60-1.43 x their size through a giant's fit, the 4x giant at 1.56 x;
+  // in chi2 the giant stood out (measured below).
   double suspect_ratio = 1.25;
   int threads = 1;
 };
@@ -28,14 +34,15 @@ struct BoardSizeScreenOptions {
 struct BoardSizeScreen {
   std::vector<BoardScale> checks;  // per view of the detections (a default one for a view the fit left out)
   std::vector<size_t> refused;     // views refused, ascending
-  // The suspect's re-check, when there was one (no view refused directly): its view and the
-  // check through the fit without it.
+  // The suspect checked again (no view refused directly, and one qualified): its view and
+  // the check through the fit without it; -1 when none.
   int suspect = -1;
   BoardScale suspect_check;
 };
 
 // `fit` from FitSensor(start, target, detections, poses, fit_options); the suspect's fit
-// without it starts from `start` and fit.poses.
+// without it starts from `start` and fit.poses. Refused that way, its entry in `checks` is
+// that check, its reason saying so.
 BoardSizeScreen ScreenBoardSizes(const Sensor& start, const CalibrationTarget& target, const DetectionSet& detections,
                                  const FitResult& fit, const FitOptions& fit_options,
                                  const BoardSizeScreenOptions& options = {});

@@ -395,12 +395,15 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   // Only through a design: from the rim circle alone the sensor's scale is a gauge and its
   // mirror family an approximation, and boards fit a little better at other sizes (on
   // rendered/ohte-sph-misaligned-near 3-4 of 8 true boards were refused that way).
-  if (fit.sensor && input.guess) {
+  // Screened again after each refit without refused boards: a second decoy, checked
+  // through a sensor the first one bent, may only show once that one is gone.
+  while (fit.sensor && input.guess) {
     BoardSizeScreenOptions screen_options;
     screen_options.threads = options.threads;
     const BoardSizeScreen screen =
         ScreenBoardSizes(fit_start, input.target, views.detections, fit, fit_options, screen_options);
     const std::vector<size_t>& refused = screen.refused;
+    if (refused.empty()) break;
     for (size_t v : refused)
       record.views_left_out[views.detections.images[v].image] = "the board " + screen.checks[v].reason;
     for (auto v = refused.rbegin(); v != refused.rend(); ++v) {
@@ -408,13 +411,11 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
       views.detections.images.erase(views.detections.images.begin() + *v);
       views.poses.erase(views.poses.begin() + *v);
     }
-    if (!refused.empty()) {
-      if (views.detections.images.size() < 3)
-        throw InputError(InputMessage(input.source, "images",
-                                      std::to_string(views.detections.images.size()) +
-                                          " views are left once the boards of another size are refused (need >= 3)"));
-      fit = FitSensor(fit_start, input.target, views.detections, views.poses, fit_options);
-    }
+    if (views.detections.images.size() < 3)
+      throw InputError(InputMessage(input.source, "images",
+                                    std::to_string(views.detections.images.size()) +
+                                        " views are left once the boards of another size are refused (need >= 3)"));
+    fit = FitSensor(fit_start, input.target, views.detections, views.poses, fit_options);
   }
   // The spline's knot count by held-out folds over the views the fit kept, then the fit
   // again with that count.

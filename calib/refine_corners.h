@@ -18,8 +18,10 @@
 // 0.068 px. On the real Mei images (grid steps 8-36 px) refining every corner made the
 // fit's halves differ more (0.317 -> 0.347 px at 2 m); refining only corners whose grid
 // step in the omni image is kMinRefinedCheckerStepPx or more improved every figure
-// (all-corner RMS 0.352 -> 0.327 px, halves 0.317 -> 0.283 px, held-out views' RMS
-// 1.30 -> 1.16 x the training views'; docs/detect.md): the default.
+// (`calibrate --board-warp`: all-corner RMS 0.352 -> 0.326 px, halves 0.317 -> 0.267 px,
+// held-out views' RMS 1.30 -> 1.15 x the training views'; docs/calibrate.md): the
+// default. On renders refining the small squares too is better (realistic checkerboard
+// through the true sensor: 0.120 -> 0.078 px RMS from the truth, docs/detection-recall.md).
 #pragma once
 
 #include <opencv2/core.hpp>

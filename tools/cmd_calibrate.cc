@@ -101,8 +101,9 @@ Command CalibrateCommand() {
             sub.add_option("--max-iterations", library.max_iterations, "Solver iterations per stage")
                 ->check(CLI::Range(1, 100000))->capture_default_str();
             sub.add_option("--detection-passes", library.detection_passes,
-                           "With --images and an aprilgrid: pass 2 re-detects the corners through the first fit's "
-                           "sensor and fits again (1: a single pass)")
+                           "With --images: pass 2 re-detects aprilgrid corners through the first fit's sensor, or "
+                           "refines checkerboard corners through it (and searches images without a board again), "
+                           "and fits again (1: a single pass; checkerboard corners are then left as found)")
                 ->check(CLI::Range(1, 5))->capture_default_str();
             sub.add_option("--tolerance", options->tolerance,
                            "Design tolerances (one std) as weak priors, name=value,...: e.g. m_mm=2,decenter_mm=1,"
