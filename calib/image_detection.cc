@@ -60,19 +60,14 @@ void DetectOne(const CalibrationTarget& target, const cv::Mat& grey, const Detec
   if (options.rim_circles) out->circle = DetectRimCircle(grey);
 }
 
-// Detects image i of `count` (get(i) gives its pixels, name(i) its name) on
-// options.threads threads, then collects the results in order.
-DetectedImages DetectAll(const CalibrationTarget& target, size_t count, const std::function<cv::Mat(size_t)>& get,
-                         const std::function<std::string(size_t)>& name, const std::string& source,
-                         const DetectionOptions& options) {
-  if (const std::string why = options.Check(); !why.empty()) throw InputError(why);
-  std::vector<OneImage> images(count);
+// one(i) for i in [0, count) on options.threads threads, one progress step each (stage
+// `stage`); rethrows the callback's exception or Cancelled once all threads have stopped.
+void PerImage(size_t count, const DetectionOptions& options, const char* stage, const std::function<void(size_t)>& one) {
   std::atomic<size_t> next{0};
-  ProgressReporter progress(options.progress, "detect", static_cast<long>(count));
+  ProgressReporter progress(options.progress, stage, static_cast<long>(count));
   auto work = [&]() {
     for (size_t i = next++; i < count; i = next++) {
-      DetectOne(target, get(i), options, &images[i]);
-      images[i].found.image = name(i);
+      one(i);
       if (!progress.Advance()) return;
     }
   };
@@ -81,6 +76,19 @@ DetectedImages DetectAll(const CalibrationTarget& target, size_t count, const st
   work();
   for (std::thread& t : pool) t.join();
   progress.ThrowIfCancelled();
+}
+
+// Detects image i of `count` (get(i) gives its pixels, name(i) its name) on
+// options.threads threads, then collects the results in order.
+DetectedImages DetectAll(const CalibrationTarget& target, size_t count, const std::function<cv::Mat(size_t)>& get,
+                         const std::function<std::string(size_t)>& name, const std::string& source,
+                         const DetectionOptions& options) {
+  if (const std::string why = options.Check(); !why.empty()) throw InputError(why);
+  std::vector<OneImage> images(count);
+  PerImage(count, options, "detect", [&](size_t i) {
+    DetectOne(target, get(i), options, &images[i]);
+    images[i].found.image = name(i);
+  });
 
   DetectedImages out;
   for (size_t i = 0; i < count; ++i) {
@@ -127,22 +135,11 @@ DetectionSet RefineFoundCorners(const CalibrationTarget& target, const Detection
                                 const DetectionOptions& options) {
   if (const std::string why = options.Check(); !why.empty()) throw InputError(why);
   DetectionSet out = found;
-  const size_t count = found.images.size();
-  std::atomic<size_t> next{0};
-  ProgressReporter progress(options.progress, "refine", static_cast<long>(count));
-  auto work = [&]() {
-    for (size_t i = next++; i < count; i = next++) {
-      const cv::Mat grey = image_of(found.images[i].image);
-      if (!grey.empty() && grey.type() == CV_8UC1)
-        out.images[i] = Refined(target, grey, GuessFor(grey, options), options, found.images[i]);
-      if (!progress.Advance()) return;
-    }
-  };
-  std::vector<std::thread> pool;
-  StartWorkers(std::min<int>(options.threads, static_cast<int>(count)), work, &pool);
-  work();
-  for (std::thread& t : pool) t.join();
-  progress.ThrowIfCancelled();
+  PerImage(found.images.size(), options, "refine", [&](size_t i) {
+    const cv::Mat grey = image_of(found.images[i].image);
+    if (!grey.empty() && grey.type() == CV_8UC1)
+      out.images[i] = Refined(target, grey, GuessFor(grey, options), options, found.images[i]);
+  });
   return out;
 }
 
