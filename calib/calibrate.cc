@@ -396,7 +396,12 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   // mirror family an approximation, and boards fit a little better at other sizes (on
   // rendered/ohte-sph-misaligned-near 3-4 of 8 true boards were refused that way).
   // Screened again after each refit without refused boards: a second decoy, checked
-  // through a sensor the first one bent, may only show once that one is gone.
+  // through a sensor the first one bent, may only show once that one is gone. At most a
+  // quarter of the views go: a true board checked through a fit without it can fit best
+  // at another size too (0.60 x with a giant still in), and a set that is mostly
+  // decoys is no calibration set; past that the screen stops with a warning.
+  const size_t max_refused = std::max<size_t>(1, views.detections.images.size() / 4);
+  size_t refused_so_far = 0;
   while (fit.sensor && input.guess) {
     BoardSizeScreenOptions screen_options;
     screen_options.threads = options.threads;
@@ -404,6 +409,17 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
         ScreenBoardSizes(fit_start, input.target, views.detections, fit, fit_options, screen_options);
     const std::vector<size_t>& refused = screen.refused;
     if (refused.empty()) break;
+    if (refused_so_far + refused.size() > max_refused) {
+      std::string names;
+      for (size_t v : refused) names += (names.empty() ? "" : ", ") + views.detections.images[v].image;
+      warnings.push_back({WarningCode::kBoardScreenStopped, "",
+                          "the board-size check would refuse " + std::to_string(refused_so_far + refused.size()) +
+                              " of " + std::to_string(views.detections.images.size() + refused_so_far) +
+                              " views (at most a quarter go): kept " + names +
+                              "; the sensor may fit them badly (a wrong guess?)"});
+      break;
+    }
+    refused_so_far += refused.size();
     for (size_t v : refused)
       record.views_left_out[views.detections.images[v].image] = "the board " + screen.checks[v].reason;
     for (auto v = refused.rbegin(); v != refused.rend(); ++v) {

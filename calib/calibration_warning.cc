@@ -22,6 +22,7 @@ const char* WarningCodeName(WarningCode code) {
     case WarningCode::kPredictedErrorHigh: return "predicted_error_high";
     case WarningCode::kHeldOutWorse: return "held_out_worse";
     case WarningCode::kKnotCountReplaced: return "knot_count_replaced";
+    case WarningCode::kBoardScreenStopped: return "board_screen_stopped";
   }
   return "unknown";
 }

@@ -25,6 +25,7 @@ enum class WarningCode {
   kPredictedErrorHigh,        // the predicted projection error exceeds the threshold
   kHeldOutWorse,              // held-out views fit much worse than the training views
   kKnotCountReplaced,         // subject: knots; the folds' count fitted no valid mirror, the next was used
+  kBoardScreenStopped,        // the board-size screen would refuse more than a quarter of the views: it kept them
 };
 
 // A stable lower-case name for programs (Python's CalibrationWarning.code), e.g.

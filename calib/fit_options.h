@@ -69,9 +69,10 @@ struct FitOptions {
   // have (a crumpled paper board, JPEG): 4 of its sigmas cut 15 of the real dev set's 480
   // corners (3.1 %), most of them on their junctions; 5 of the bulk's cut 4 (0.8 %). On
   // Gaussian noise the two sigmas agree and 5 sigma cuts 4e-6 of the corners. The floor
-  // keeps a very good fit (renders: 0.02 px) from throwing good corners away. The bulk
-  // reaches at least as far as the cut (outlier_bulk_sigmas >= outlier_sigmas), so every
-  // corner the fit keeps counts in the sigma that judges it.
+  // keeps a very good fit (renders: 0.02 px) from throwing good corners away. With
+  // outlier_bulk_sigmas >= outlier_sigmas the bulk reaches past the cut where the
+  // residuals are near-Gaussian (the two sigmas then agree), so the corners the fit keeps
+  // count in the sigma that judges them; where the floor sets the cut it may not.
   double outlier_floor_px = 0.5;
   double outlier_sigmas = 5.0;
   double outlier_bulk_sigmas = 8.0;

@@ -459,6 +459,8 @@ TEST(BoardScale, RefusesADistantGiantAndKeepsTheBoards) {
         EXPECT_GT(check.best_scale, BoardScaleOptions().max_size_ratio) << check.reason;
       }
     }
+    // The 4x giant goes as the suspect, through a fit without it; the 10x one directly.
+    EXPECT_EQ(screen.suspect, scale == 4.0 ? 3 : -1) << "scale " << scale;
   }
 }
 
@@ -477,8 +479,38 @@ TEST(BoardScale, CalibrateRefusesTwoGiantsOneByOne) {
   input.source = "two giants";
   const CalibrationRecord record = Calibrate(input, CalibrationOptions()).record;
   std::set<std::string> refused;
-  for (const auto& [image, why] : record.views_left_out) refused.insert(image), std::printf("%s: %s\n", image.c_str(), why.c_str());
+  int as_suspect = 0;
+  for (const auto& [image, why] : record.views_left_out) {
+    refused.insert(image);
+    as_suspect += why.find("(through a fit without this view)") != std::string::npos;
+    std::printf("%s: %s\n", image.c_str(), why.c_str());
+  }
   EXPECT_EQ(refused, (std::set<std::string>{input.detections->images[3].image, input.detections->images[8].image}));
+  // One directly (view 3, 1.66 x), then, screened again after the refit, the other as the
+  // suspect (view 8, 8.4 x through a fit without it).
+  EXPECT_EQ(as_suspect, 1);
+}
+
+// Four 4x giants among 12 views: a quarter (3) may go, so the screen refuses views until
+// the next refusal would pass that, then keeps the rest and warns (board_screen_stopped)
+// rather than eat into the set. The limit this guards, measured: with a third of the
+// views giants the fit is bent so far that a true board (view 1, 2.58 x through it) is
+// refused with two of the giants; without the cap the screen went on.
+TEST(BoardScale, CalibrateRefusesAtMostAQuarterOfTheViews) {
+  CalibrationInput input;
+  input.target_name = testing::SourceDir() + "/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml";
+  input.target = Board();
+  input.guess = LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-sph-misaligned-guess.yaml");
+  input.detections = WithGiantView(4.0, 10, 37, WithGiantView(4.0, 6, 35, WithGiantView(4.0, 8, 33, WithGiantView(4.0, 3, 31))));
+  input.detections->image_width_px = Truth().image_width_px();
+  input.detections->image_height_px = Truth().image_height_px();
+  input.source = "four giants";
+  const CalibrationResult result = Calibrate(input, CalibrationOptions());
+  for (const auto& [image, why] : result.record.views_left_out) std::printf("%s: %s\n", image.c_str(), why.c_str());
+  EXPECT_EQ(result.record.views_left_out.size(), 3u);
+  int stopped = 0;
+  for (const CalibrationWarning& w : result.warnings) stopped += w.code == WarningCode::kBoardScreenStopped;
+  EXPECT_EQ(stopped, 1);
 }
 
 // A bent board is the printed board: the realistic render's board at the inner radius
