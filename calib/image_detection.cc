@@ -63,7 +63,8 @@ void DetectOne(const CalibrationTarget& target, const cv::Mat& grey, const Detec
 // one(i) for i in [0, count) on options.threads threads, one progress step each (stage
 // `stage`); once all threads have stopped, rethrows what the progress callback threw, or
 // Cancelled. `one` must not throw (it runs on worker threads).
-void PerImage(size_t count, const DetectionOptions& options, const char* stage, const std::function<void(size_t)>& one) {
+void PerImage(size_t count, const DetectionOptions& options, const char* stage,
+              const std::function<void(size_t)>& one) {
   std::atomic<size_t> next{0};
   ProgressReporter progress(options.progress, stage, static_cast<long>(count));
   auto work = [&]() {

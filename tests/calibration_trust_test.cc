@@ -501,7 +501,8 @@ TEST(BoardScale, CalibrateRefusesAtMostAQuarterOfTheViews) {
   input.target_name = testing::SourceDir() + "/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml";
   input.target = Board();
   input.guess = LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-sph-misaligned-guess.yaml");
-  input.detections = WithGiantView(4.0, 10, 37, WithGiantView(4.0, 6, 35, WithGiantView(4.0, 8, 33, WithGiantView(4.0, 3, 31))));
+  input.detections =
+      WithGiantView(4.0, 10, 37, WithGiantView(4.0, 6, 35, WithGiantView(4.0, 8, 33, WithGiantView(4.0, 3, 31))));
   input.detections->image_width_px = Truth().image_width_px();
   input.detections->image_height_px = Truth().image_height_px();
   input.source = "four giants";

@@ -78,7 +78,8 @@ TEST(RealImages, MeiParabolicDetectsAndCalibrates) {
     if (auto circle = DetectRimCircle(cv::imread(kData + "/" + image.image, cv::IMREAD_GRAYSCALE))) circles.push_back(*circle);
   ASSERT_EQ(circles.size(), 10u);
   const RimCircle rim = *MedianRimCircle(circles);
-  for (const auto& [profile, rms_bound] : std::vector<std::pair<std::string, double>>{{"polynomial", 0.45}, {"paraboloid", 1.3}}) {
+  for (const auto& [profile, rms_bound] :
+       std::vector<std::pair<std::string, double>>{{"polynomial", 0.45}, {"paraboloid", 1.3}}) {
     const Sensor guess = SensorFromRimCircle(rim, detections.image_width_px, detections.image_height_px, profile);
     std::vector<TargetPose> poses(detections.images.size());
     for (size_t v = 0; v < poses.size(); ++v) ASSERT_TRUE(InitialTargetPose(guess, board, detections.images[v], &poses[v])) << v;

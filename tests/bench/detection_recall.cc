@@ -80,7 +80,8 @@ int main() {
         if (through_views) detected = DetectThroughVirtualViews(target, grey, guess, detected);
         const double min_checker_step_px = tags ? 0.0 : kMinRefinedCheckerStepPx;  // the default (detect's)
         if (mode == 1) detected = RefineCorners(target, grey, nullptr, detected, nullptr, min_checker_step_px);
-        if (mode == 3 || mode == 4) detected = RefineCorners(target, grey, &guess, detected, nullptr, min_checker_step_px);
+        if (mode == 3 || mode == 4)
+          detected = RefineCorners(target, grey, &guess, detected, nullptr, min_checker_step_px);
         seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         std::map<int, Eigen::Vector2d> expected;
         for (const CornerObservation& c : view.corners) expected[c.id] = c.pixel;
