@@ -50,11 +50,11 @@ BoardSizeScreen ScreenBoardSizes(const Sensor& start, const CalibrationTarget& t
   quiet.compute_covariance = false;
   const FitResult without = FitSensor(start, target, others, poses, quiet);
   if (!without.sensor) return screen;
-  screen.suspect_check = CheckBoardScale(*without.sensor, target, detections.images[suspect], fit.poses[suspect],
-                                         without.sigma_px, options.scale, WarpOf(without, fit_options));
-  if (screen.suspect_check.refused) {
-    screen.suspect_check.reason = "(through a fit without this view) " + screen.suspect_check.reason;
-    screen.checks[suspect] = screen.suspect_check;
+  BoardScale check = CheckBoardScale(*without.sensor, target, detections.images[suspect], fit.poses[suspect],
+                                     without.sigma_px, options.scale, WarpOf(without, fit_options));
+  if (check.refused) {
+    check.reason = "(through a fit without this view) " + check.reason;
+    screen.checks[suspect] = check;
     screen.refused.push_back(suspect);
   }
   return screen;

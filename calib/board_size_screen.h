@@ -35,15 +35,13 @@ struct BoardSizeScreenOptions {
 struct BoardSizeScreen {
   std::vector<BoardScale> checks;  // per view of the detections (a default one for a view the fit left out)
   std::vector<size_t> refused;     // views refused, ascending
-  // The suspect checked again (no view refused directly, and one qualified): its view and
-  // the check through the fit without it; -1 when none.
+  // The view checked again through a fit without it (no view refused directly, and one
+  // qualified); -1 when none. Refused that way, its entry in `checks` is that check.
   int suspect = -1;
-  BoardScale suspect_check;
 };
 
 // `fit` from FitSensor(start, target, detections, poses, fit_options); the suspect's fit
-// without it starts from `start` and fit.poses. Refused that way, its entry in `checks` is
-// that check, its reason saying so.
+// without it starts from `start` and fit.poses.
 BoardSizeScreen ScreenBoardSizes(const Sensor& start, const CalibrationTarget& target, const DetectionSet& detections,
                                  const FitResult& fit, const FitOptions& fit_options,
                                  const BoardSizeScreenOptions& options = {});

@@ -198,7 +198,7 @@ DetectionSet CheckerboardsRefinedThrough(const CalibrationInput& input, const Ca
   detection.progress = options.progress;
   std::map<std::string, const cv::Mat*> in_memory;
   for (const NamedImage& image : input.images) in_memory[image.name] = &image.grey;
-  DetectionSet refined = RefineFoundCorners(
+  return RefineFoundCorners(
       input.target, found,
       [&](const std::string& name) {
         if (!input.image_paths.empty()) return ReadImageFile(name, cv::IMREAD_GRAYSCALE);
@@ -206,7 +206,6 @@ DetectionSet CheckerboardsRefinedThrough(const CalibrationInput& input, const Ca
         return it == in_memory.end() ? cv::Mat() : *it->second;
       },
       detection);
-  return refined;
 }
 
 // The fit's tolerances: the guess's (those that apply to the fitted family), then the

@@ -191,10 +191,14 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
     const std::vector<int> neighbour_ids = NeighboursOf(target, corner.id);
     bool moved = false;
     Eigen::Vector2d refined;
-    double omni_step_px = HUGE_VAL;
-    for (int n : neighbour_ids)
-      if (by_id.count(n)) omni_step_px = std::min(omni_step_px, (by_id[n] - corner.pixel).norm());
-    if (target.type() == CalibrationTarget::Type::kCheckerboard && !(omni_step_px >= min_checker_step_px)) {
+    bool small_square = false;
+    if (target.type() == CalibrationTarget::Type::kCheckerboard && min_checker_step_px > 0.0) {
+      double omni_step_px = HUGE_VAL;
+      for (int n : neighbour_ids)
+        if (by_id.count(n)) omni_step_px = std::min(omni_step_px, (by_id[n] - corner.pixel).norm());
+      small_square = !(omni_step_px >= min_checker_step_px);
+    }
+    if (small_square) {
       // kept as detected (below)
     } else if (!guess) {
       std::vector<Eigen::Vector2d> neighbours;
