@@ -62,8 +62,16 @@ class TagDetector {
 
 // AprilTag 3 over an image (corners in its pixel-centre coordinates): the target's ids
 // only, and an id decoded twice dropped altogether (which copy is the tag is unknown).
+// A tag36h11 tag is 10 cells across with its white border, each at least a pixel to be
+// decoded.
+constexpr int kMinTagImagePx = 10;
+
 std::map<int, std::array<Eigen::Vector2d, 4>> DetectTags(const CalibrationTarget& target, const cv::Mat& image,
                                                          DetectionStats* stats) {
+  // AprilTag 3.3 reads out of bounds on images 2 rows high or less (a segfault), and no
+  // tag fits in fewer than kMinTagImagePx rows or columns.
+  if (stats) *stats = {};
+  if (image.rows < kMinTagImagePx || image.cols < kMinTagImagePx) return {};
   apriltag_detector_t* detector = TagDetector::ForThisThread(target.family());
   cv::Mat continuous = image.isContinuous() ? image : image.clone();
   image_u8_t frame{continuous.cols, continuous.rows, static_cast<int32_t>(continuous.step), continuous.data};

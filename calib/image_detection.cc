@@ -2,15 +2,13 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include <atomic>
 #include <functional>
-#include <thread>
 
 #include "calib/detect.h"
 #include "calib/image_file.h"
 #include "calib/refine_corners.h"
 #include "model/input_error.h"
-#include "model/worker_threads.h"
+#include "model/parallel_rows.h"
 
 namespace omnical {
 namespace {
@@ -61,23 +59,16 @@ void DetectOne(const CalibrationTarget& target, const cv::Mat& grey, const Detec
 }
 
 // one(i) for i in [0, count) on options.threads threads, one progress step each (stage
-// `stage`); once all threads have stopped, rethrows what the progress callback threw, or
-// Cancelled. `one` must not throw (it runs on worker threads).
+// `stage`). What `one` throws stops the images not yet started and is rethrown here once
+// every thread has stopped (on a worker thread it would end the process); so is what the
+// progress callback threw, or Cancelled.
 void PerImage(size_t count, const DetectionOptions& options, const char* stage,
               const std::function<void(size_t)>& one) {
-  std::atomic<size_t> next{0};
   ProgressReporter progress(options.progress, stage, static_cast<long>(count));
-  auto work = [&]() {
-    for (size_t i = next++; i < count; i = next++) {
-      one(i);
-      if (!progress.Advance()) return;
-    }
-  };
-  std::vector<std::thread> pool;
-  StartWorkers(std::min<int>(options.threads, static_cast<int>(count)), work, &pool);
-  work();
-  for (std::thread& t : pool) t.join();
-  progress.ThrowIfCancelled();
+  ParallelRows(static_cast<int>(count), options.threads, [&](int i) {
+    one(static_cast<size_t>(i));
+    if (!progress.Advance()) progress.ThrowIfCancelled();
+  });
 }
 
 // Detects image i of `count` (get(i) gives its pixels, name(i) its name) on
@@ -88,7 +79,14 @@ DetectedImages DetectAll(const CalibrationTarget& target, size_t count, const st
   if (const std::string why = options.Check(); !why.empty()) throw InputError(why);
   std::vector<OneImage> images(count);
   PerImage(count, options, "detect", [&](size_t i) {
-    DetectOne(target, get(i), options, &images[i]);
+    // An image the decoder or a detector chokes on (OpenCV throws on some corrupt files
+    // and absurd sizes) is skipped like an unreadable one, not the whole set.
+    try {
+      DetectOne(target, get(i), options, &images[i]);
+    } catch (const cv::Exception& error) {
+      images[i] = OneImage{};
+      images[i].problem = "OpenCV failed on it (" + error.err + ")";
+    }
     images[i].found.image = name(i);
   });
 

@@ -14,6 +14,7 @@
 
 #include "calib/calibrate.h"
 #include "calib/calibration_json.h"
+#include "calib/detect.h"
 #include "calib/image_file.h"
 #include "calib/synthetic/ground_truth.h"
 #include "model/input_error.h"
@@ -213,6 +214,27 @@ TEST(CalibrateApi, DetectsImagesInMemoryAsFromFiles) {
   }
   std::vector<NamedImage> colour = {{"colour", cv::Mat(8, 8, CV_8UC3)}};
   EXPECT_THROW(DetectImages(target, colour, options), InputError);
+}
+
+// Images too small for any tag (AprilTag 3.3 read out of bounds on those 2 rows high and
+// crashed the process) give no corners; an image the callback cannot supply throws on a
+// worker thread, and that reaches the caller (it used to end the process).
+TEST(CalibrateApi, TinyImagesAndThrowingCallbacksDoNotCrash) {
+  const CalibrationTarget target =
+      CalibrationTarget::FromYaml(testing::SourceDir() + "/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml");
+  for (const cv::Size size : {cv::Size(1, 1), cv::Size(64, 2), cv::Size(2, 64), cv::Size(9, 9)}) {
+    const cv::Mat grey(size, CV_8UC1, cv::Scalar(128));
+    EXPECT_TRUE(DetectTarget(target, grey).corners.empty()) << size;
+  }
+  const DetectionSet found = DetectImageFiles(target, {testing::SourceDir() + kSet + "/near000.png",
+                                                       testing::SourceDir() + kSet + "/near001.png"},
+                                              "two renders", DetectionOptions{})
+                                 .detections;
+  DetectionOptions options;
+  options.threads = 2;
+  EXPECT_THROW(RefineFoundCorners(target, found, [](const std::string&) -> cv::Mat { throw std::runtime_error("no pixels"); },
+                                  options),
+               std::runtime_error);
 }
 
 }  // namespace
