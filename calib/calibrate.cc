@@ -52,6 +52,14 @@ DetectionSet FittableCorners(const CalibrationInput& input, DetectionSet detecti
   return detections;
 }
 
+// Without the images in `names` (views refused by the board-size screen).
+DetectionSet WithoutImages(DetectionSet detections, const std::set<std::string>& names) {
+  auto& images = detections.images;
+  images.erase(std::remove_if(images.begin(), images.end(), [&](const ImageDetections& i) { return names.count(i.image) > 0; }),
+               images.end());
+  return detections;
+}
+
 struct UsableViews {
   DetectionSet detections;  // the views with a starting pose
   std::vector<TargetPose> poses;
@@ -358,6 +366,63 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
                      " views (need >= 3 per half, >= 6 usable views in all)");
   std::optional<Sensor> refit_start;  // the previous pass's fit, where the last fit started
   FitResult fit = FitSensor(guess, input.target, views.detections, views.poses, fit_options);
+  // Boards of another size than the target (a decoy the detector accepted, e.g. a window
+  // of tiles that passed the continuation test) are refused through the fitted sensor (a
+  // suspect through a fit without it) and the fit is repeated without them
+  // (calib/board_size_screen.h).
+  // Only through a design: from the rim circle alone the sensor's scale is a gauge and its
+  // mirror family an approximation, and boards fit a little better at other sizes (on
+  // rendered/ohte-sph-misaligned-near 3-4 of 8 true boards were refused that way).
+  // Screened again after each refit without refused boards: a second decoy, checked
+  // through a sensor the first one bent, may only show once that one is gone. At most a
+  // quarter of the views go: a true board checked through a fit without it can fit best
+  // at another size too (0.60 x with a giant still in), and a set that is mostly
+  // decoys is no calibration set; past that the screen stops with a warning.
+  // Screened after the first fit too: the second detection pass refines the corners
+  // through that fit, and its refits start there. A decoy refused only after it (a 3.8 x
+  // giant among the realistic aprilgrid render's 12 views) had moved fx and m by 0.9 and
+  // 0.8 std from the fit without its image.
+  const size_t max_refused = std::max<size_t>(1, views.detections.images.size() / 4);
+  size_t refused_so_far = 0;
+  bool screen_stopped = false;
+  std::set<std::string> refused_images;  // kept out of later detection passes
+  auto screen_and_refit = [&](const Sensor& start) {
+    while (fit.sensor && input.guess && !screen_stopped) {
+      BoardSizeScreenOptions screen_options;
+      screen_options.threads = options.threads;
+      const BoardSizeScreen screen =
+          ScreenBoardSizes(start, input.target, views.detections, fit, fit_options, screen_options);
+      const std::vector<size_t>& refused = screen.refused;
+      if (refused.empty()) return;
+      if (refused_so_far + refused.size() > max_refused) {
+        std::string names;
+        for (size_t v : refused) names += (names.empty() ? "" : ", ") + views.detections.images[v].image;
+        warnings.push_back({WarningCode::kBoardScreenStopped, "",
+                            "the board-size check would refuse " + std::to_string(refused_so_far + refused.size()) +
+                                " of " + std::to_string(views.detections.images.size() + refused_so_far) +
+                                " views (at most a quarter go): kept " + names +
+                                "; the sensor may fit them badly (a wrong guess?)"});
+        screen_stopped = true;
+        return;
+      }
+      refused_so_far += refused.size();
+      for (size_t v : refused) {
+        record.views_left_out[views.detections.images[v].image] = "the board " + screen.checks[v].reason;
+        refused_images.insert(views.detections.images[v].image);
+      }
+      for (auto v = refused.rbegin(); v != refused.rend(); ++v) {
+        views.observations -= static_cast<int>(views.detections.images[*v].corners.size());
+        views.detections.images.erase(views.detections.images.begin() + *v);
+        views.poses.erase(views.poses.begin() + *v);
+      }
+      if (views.detections.images.size() < 3)
+        throw InputError(InputMessage(input.source, "images",
+                                      std::to_string(views.detections.images.size()) +
+                                          " views are left once the boards of another size are refused (need >= 3)"));
+      fit = FitSensor(start, input.target, views.detections, views.poses, fit_options);
+    }
+  };
+  screen_and_refit(guess);
   // Second detection pass, from images. Aprilgrids: the corners are refined in patches
   // through a sensor, and a tag's straight edges are straight there only as far as that
   // sensor is right. Through the design guess the patch edges bend, and the corners
@@ -382,56 +447,14 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     warnings.erase(std::remove_if(warnings.begin(), warnings.end(),
                                   [](const CalibrationWarning& w) { return w.code == WarningCode::kViewSkipped; }),
                    warnings.end());
-    views = ViewsForFit(*refit_start, input, FittableCorners(input, detections, &unrefined), &warnings);
+    // Boards refused so far stay out (their corners stay in `detections`: every corner found).
+    views = ViewsForFit(*refit_start, input, FittableCorners(input, WithoutImages(detections, refused_images), &unrefined),
+                        &warnings);
     held = SplitOff(&views, holdout_names);
     fit = FitSensor(*refit_start, input.target, views.detections, views.poses, fit_options);
   }
   Sensor fit_start = refit_start ? *refit_start : guess;
-  // Boards of another size than the target (a decoy the detector accepted, e.g. a window
-  // of tiles that passed the continuation test) are refused through the fitted sensor (a
-  // suspect through a fit without it) and the fit is repeated without them
-  // (calib/board_size_screen.h).
-  // Only through a design: from the rim circle alone the sensor's scale is a gauge and its
-  // mirror family an approximation, and boards fit a little better at other sizes (on
-  // rendered/ohte-sph-misaligned-near 3-4 of 8 true boards were refused that way).
-  // Screened again after each refit without refused boards: a second decoy, checked
-  // through a sensor the first one bent, may only show once that one is gone. At most a
-  // quarter of the views go: a true board checked through a fit without it can fit best
-  // at another size too (0.60 x with a giant still in), and a set that is mostly
-  // decoys is no calibration set; past that the screen stops with a warning.
-  const size_t max_refused = std::max<size_t>(1, views.detections.images.size() / 4);
-  size_t refused_so_far = 0;
-  while (fit.sensor && input.guess) {
-    BoardSizeScreenOptions screen_options;
-    screen_options.threads = options.threads;
-    const BoardSizeScreen screen =
-        ScreenBoardSizes(fit_start, input.target, views.detections, fit, fit_options, screen_options);
-    const std::vector<size_t>& refused = screen.refused;
-    if (refused.empty()) break;
-    if (refused_so_far + refused.size() > max_refused) {
-      std::string names;
-      for (size_t v : refused) names += (names.empty() ? "" : ", ") + views.detections.images[v].image;
-      warnings.push_back({WarningCode::kBoardScreenStopped, "",
-                          "the board-size check would refuse " + std::to_string(refused_so_far + refused.size()) +
-                              " of " + std::to_string(views.detections.images.size() + refused_so_far) +
-                              " views (at most a quarter go): kept " + names +
-                              "; the sensor may fit them badly (a wrong guess?)"});
-      break;
-    }
-    refused_so_far += refused.size();
-    for (size_t v : refused)
-      record.views_left_out[views.detections.images[v].image] = "the board " + screen.checks[v].reason;
-    for (auto v = refused.rbegin(); v != refused.rend(); ++v) {
-      views.observations -= static_cast<int>(views.detections.images[*v].corners.size());
-      views.detections.images.erase(views.detections.images.begin() + *v);
-      views.poses.erase(views.poses.begin() + *v);
-    }
-    if (views.detections.images.size() < 3)
-      throw InputError(InputMessage(input.source, "images",
-                                    std::to_string(views.detections.images.size()) +
-                                        " views are left once the boards of another size are refused (need >= 3)"));
-    fit = FitSensor(fit_start, input.target, views.detections, views.poses, fit_options);
-  }
+  if (passes_run > 1) screen_and_refit(fit_start);  // the corners changed
   // The spline's knot count by held-out folds over the views the fit kept, then the fit
   // again with that count.
   std::string knot_fallback;  // why the fitted count is not the folds' choice
