@@ -11,8 +11,7 @@ set -u
 omnical=$1
 source_dir=$(cd "$2" && pwd)
 data=$source_dir/datasets-synthetic
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
 
 sed 's/tagSize: 0.030/tagSize: 0.120/' "$data/targets/aprilgrid-6x6-30mm.yaml" >"$work/giant.yaml"
 cat >"$work/scene.yaml" <<EOF
