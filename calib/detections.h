@@ -27,11 +27,13 @@ struct DetectionSet {
   std::string target_spec;  // the spec file the ids refer to
   int image_width_px = 0, image_height_px = 0;
   std::vector<ImageDetections> images;
+  std::string target_description;  // CalibrationTarget::Describe() of it ("" in files from before it was written)
 };
 
 // JSON: {"target": spec, "image_size": [W, H], "images": [{"image": path,
 // "corners": [{"id": i, "pixel": [u, v]}, ...]}, ...]}; an unrefined corner also has
-// "refined": false. Read throws InputError naming the
+// "refined": false; "target_description" (optional) describes the board the corners were
+// found on (CalibrationTarget::Describe). Read throws InputError naming the
 // file and the entry; write is atomic.
 DetectionSet ReadDetections(const std::string& path);
 void WriteDetections(const DetectionSet& detections, const std::string& path);

@@ -91,6 +91,7 @@ DetectedImages DetectAll(const CalibrationTarget& target, size_t count, const st
   });
 
   DetectedImages out;
+  out.detections.target_description = target.Describe();
   for (size_t i = 0; i < count; ++i) {
     OneImage& image = images[i];
     if (image.problem.empty() && out.detections.images.empty()) {

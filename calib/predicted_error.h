@@ -18,11 +18,12 @@
 #include "calib/bundle_fit.h"
 #include "calib/detections.h"
 #include "calib/target.h"
+#include "model/object_distance.h"
 #include "model/sensor.h"
 
 namespace omnical {
 
-inline constexpr double kInfinityMm = 1e8;
+inline constexpr double kInfinityMm = kMaxObjectDistanceMm;  // 100 km
 
 // An annulus around the principal point: the radii the calibration's corners cover, all
 // round (the mirror is rotationally symmetric; a user's panorama uses every azimuth).

@@ -138,6 +138,17 @@ CalibrationTarget CalibrationTarget::AprilGrid(int cols, int rows, double tag_si
   return target;
 }
 
+std::string CalibrationTarget::Describe() const {
+  char text[200];
+  if (type_ == Type::kAprilGrid)
+    std::snprintf(text, sizeof text, "aprilgrid %d x %d %s from id %d, %.6g mm tags, spacing %.6g", cols_, rows_, family_.c_str(),
+                  code_offset_, tag_size_mm_, spacing_ratio_);
+  else
+    std::snprintf(text, sizeof text, "checkerboard %d x %d corners, %.6g x %.6g mm squares", cols_, rows_, col_spacing_mm_,
+                  row_spacing_mm_);
+  return text;
+}
+
 CalibrationTarget CalibrationTarget::Checkerboard(int cols, int rows, double col_spacing_mm, double row_spacing_mm) {
   CalibrationTarget target;
   target.type_ = Type::kCheckerboard;

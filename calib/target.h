@@ -46,6 +46,10 @@ class CalibrationTarget {
   double tag_size_mm() const { return tag_size_mm_; }
   double spacing_ratio() const { return spacing_ratio_; }
   const std::vector<TargetCorner>& corners() const { return corners_; }
+  // What the corner ids and positions depend on, in words ("aprilgrid 6 x 6 tag36h11 from
+  // id 0, 30 mm tags, spacing 0.3"): recorded with detections, so that corners are not
+  // fitted to another board than the one they were found on.
+  std::string Describe() const;
 
   // The printed board's extent in the board frame (mm), margins included.
   Eigen::Vector2d min_mm() const { return min_mm_; }

@@ -11,6 +11,7 @@
 #include "correction/view_request.h"
 #include "model/io/atomic_write.h"
 #include "model/input_error.h"
+#include "model/object_distance.h"
 #include "model/optics.h"
 
 namespace omnical {
@@ -82,9 +83,13 @@ std::string CentralExportOptions::Check() const {
     const double distance = distance_mm ? *distance_mm : *n;
     if (!std::isfinite(distance) || distance <= 0.0)
       return std::string(n ? "n" : "distance_mm") + ": the object distance must be > 0";
+    // n's distance in mm is checked once the rim radius is known (ExportCentral).
+    if (distance_mm)
+      if (const std::string why = ObjectDistanceProblem(*distance_mm); !why.empty()) return "distance_mm: " + why;
   }
   if (!(step_px >= 1.0)) return "step_px: must be >= 1";
-  if (v0_mm && !std::isfinite(*v0_mm)) return "v0_mm: not finite";
+  if (v0_mm)
+    if (const std::string why = ViewpointProblem(*v0_mm); !why.empty()) return "v0_mm: " + why;
   return "";
 }
 
@@ -101,8 +106,9 @@ CentralExportResult ExportCentral(const Sensor& sensor, const CentralExportOptio
   const double rim = result.rim_radius_mm = sensor.rim_radius_mm();
   result.image_width_px = sensor.image_width_px(), result.image_height_px = sensor.image_height_px();
   if (options.distance_mm || options.n) result.surface = SphereAt(options.distance_mm ? *options.distance_mm : *options.n * rim);
-  if (!std::isfinite(result.surface.distance_mm))
-    throw InputError(std::string(options.n ? "n" : "distance_mm") + ": the object distance must be > 0");
+  if (options.distance_mm || options.n)
+    if (const std::string why = ObjectDistanceProblem(result.surface.distance_mm); !why.empty())
+      throw InputError(std::string(options.n ? "n" : "distance_mm") + ": " + why);
   const double reference_mm = ReferenceDistanceMm(sensor, result.surface);
   const double v0_mm = result.v0_mm = ResolveV0Mm(AnalyzeField(sensor, 360, reference_mm), reference_mm, options.v0_mm);
 

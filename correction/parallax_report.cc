@@ -10,15 +10,18 @@
 
 #include "model/io/atomic_write.h"
 #include "model/input_error.h"
+#include "model/object_distance.h"
 #include "model/optics.h"
 
 namespace omnical {
 
 std::string ParallaxOptions::Check() const {
-  if (distance_mm.has_value() == n.has_value()) return "distance_mm: give the object distance (distance_mm or n)";
+  if (distance_mm && n) return "n: give only one of distance_mm and n";
+  if (!distance_mm && !n) return "distance_mm: give the object distance (distance_mm or n)";
   const double distance = distance_mm ? *distance_mm : *n;
   if (!(std::isfinite(distance) && distance > 0.0)) return std::string(n ? "n" : "distance_mm") + ": must be > 0";
-  if (v0_mm && !std::isfinite(*v0_mm)) return "v0_mm: not finite";
+  if (v0_mm)
+    if (const std::string why = ViewpointProblem(*v0_mm); !why.empty()) return "v0_mm: " + why;
   if (samples < 10 || samples > 100000) return "samples: " + std::to_string(samples) + " (10..100000)";
   if (threads < 0) return "threads: must be >= 0";
   return "";
@@ -29,6 +32,8 @@ ParallaxResult ParallaxReport(const Sensor& sensor, const ParallaxOptions& optio
   ParallaxResult result;
   const double rim = sensor.rim_radius_mm();
   result.distance_mm = options.distance_mm ? *options.distance_mm : *options.n * rim;
+  if (const std::string why = ObjectDistanceProblem(result.distance_mm); !why.empty())
+    throw InputError(std::string(options.n ? "n" : "distance_mm") + ": " + why);
   result.n = result.distance_mm / rim;
   result.axial = sensor.is_axial();
   const std::vector<FieldSample> field = AnalyzeField(sensor, options.samples, result.distance_mm);

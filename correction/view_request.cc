@@ -7,6 +7,7 @@
 
 #include "correction/viewpoint_error.h"
 #include "model/input_error.h"
+#include "model/object_distance.h"
 
 namespace omnical {
 namespace {
@@ -45,7 +46,8 @@ std::string ViewRequest::Check() const {
     if (plane_normal.size() != 3 || !finite || Eigen::Vector3d(plane_normal[0], plane_normal[1], plane_normal[2]).norm() <= 0.0)
       return FieldMessage("plane_normal", "zero or not finite");
   }
-  if (v0_mm && !std::isfinite(*v0_mm)) return FieldMessage("v0_mm", "not finite");
+  if (v0_mm)
+    if (const std::string why = ViewpointProblem(*v0_mm); !why.empty()) return FieldMessage("v0_mm", why);
   if (threads < 0) return FieldMessage("threads", "must be >= 0");
   return "";
 }
@@ -70,7 +72,8 @@ ResolvedView ResolveView(const Sensor& sensor, const ViewRequest& request) {
   if (!request.infinity) {
     surface.kind = *ParseSurfaceKind(request.surface);
     surface.distance_mm = request.distance_mm ? *request.distance_mm : *request.n * rim;
-    if (!std::isfinite(surface.distance_mm)) throw InputError(FieldMessage(request.n ? "n" : "distance_mm", "the object distance must be > 0"));
+    if (const std::string why = ObjectDistanceProblem(surface.distance_mm); !why.empty())
+      throw InputError(FieldMessage(request.n ? "n" : "distance_mm", why));
   }
   if (!request.plane_normal.empty())
     surface.plane_normal =
@@ -110,7 +113,7 @@ double ReferenceDistanceMm(const Sensor& sensor, const ObjectSurface& surface) {
 
 double ResolveV0Mm(const std::vector<FieldSample>& field, double reference_distance_mm, const std::optional<double>& given) {
   if (!given) return BestViewpointMm(field, reference_distance_mm);
-  if (!std::isfinite(*given)) throw InputError(FieldMessage("v0_mm", "not finite"));
+  if (const std::string why = ViewpointProblem(*given); !why.empty()) throw InputError(FieldMessage("v0_mm", why));
   return *given;
 }
 

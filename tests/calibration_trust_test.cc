@@ -427,7 +427,7 @@ DetectionSet WithGiantView(double scale, size_t view, unsigned seed, DetectionSe
     Eigen::Vector2d pixel;
     if (Truth().Project(point, &pixel) == ProjectionStatus::kOk) image.corners.push_back({c.id, pixel});
   }
-  set.images[view] = WithNoise(DetectionSet{"", 0, 0, {image}}, 0.1, seed + 7).images[0];
+  set.images[view] = WithNoise(DetectionSet{"", 0, 0, {image}, ""}, 0.1, seed + 7).images[0];
   return set;
 }
 

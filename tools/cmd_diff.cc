@@ -10,6 +10,7 @@
 #include "model/io/atomic_write.h"
 #include "model/io/sensor_yaml.h"
 #include "tools/commands.h"
+#include "tools/field_flags.h"
 
 namespace omnical::cli {
 namespace {
@@ -40,8 +41,11 @@ void RunDiff(const DiffFlags& options, const Context& context) {
     field_name = (std::filesystem::path(options.a) / "detections.json").string();
   std::optional<DetectionSet> detections;
   if (!field_name.empty()) detections = ReadDetections(field_name);
-  const std::vector<Eigen::Vector2d> field = ComparisonField(a, detections ? &*detections : nullptr, options.step_px);
-  const ProjectionDiff diff = CompareProjections(a, b, field, options.distance_mm, !options.no_align);
+  const FlagTable flags = FlagsOf({"distance_mm", "step_px"});
+  const std::vector<Eigen::Vector2d> field =
+      NamingFlags(flags, [&] { return ComparisonField(a, detections ? &*detections : nullptr, options.step_px); });
+  const ProjectionDiff diff =
+      NamingFlags(flags, [&] { return CompareProjections(a, b, field, options.distance_mm, !options.no_align); });
   const std::string field_label = field_name.empty() ? "every pixel of the mirror" : "the corners' annulus in " + field_name;
   if (!options.out_dir.empty()) {
     const std::filesystem::path dir(options.out_dir);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 #include "correction/unwarp.h"
@@ -41,7 +42,15 @@ Unwarper MakeUnwarper(const UnwarpFlags& options, const ProgressCallback& progre
 
 // The video through the unwarper into options.out (MJPG .avi or mp4v .mp4), atomically.
 long UnwarpVideo(const Unwarper& unwarper, const UnwarpFlags& options, const ProgressCallback& progress) {
-  cv::VideoCapture capture(options.input);
+  // Checked here, and read through FFmpeg alone: OpenCV otherwise tries GStreamer and an
+  // image-sequence reader first, and each failure printed several lines before our one.
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(options.input, error)) throw InputError(InputMessage(options.input, "", "file not found"));
+  if (std::filesystem::file_size(options.input, error) == 0) throw InputError(InputMessage(options.input, "", "is empty"));
+  // FFmpeg's own messages on a corrupt file ("[png @ 0x...] chunk too big") too, unless
+  // the user asked for them: OpenCV reads this when it first starts FFmpeg.
+  ::setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);  // AV_LOG_QUIET
+  cv::VideoCapture capture(options.input, cv::CAP_FFMPEG);
   if (!capture.isOpened()) throw InputError(InputMessage(options.input, "", "cannot be opened as a video"));
   const std::string extension = LowerExtension(options.out);
   const int fourcc = extension == ".avi" ? cv::VideoWriter::fourcc('M', 'J', 'P', 'G')

@@ -46,7 +46,9 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
   std::vector<double> magnitudes;
   for (const auto& view : fit.residuals_px)
     for (const Eigen::Vector2d& r : view)
-      if (std::isfinite(r.x())) magnitudes.push_back(r.norm()), worst = std::max(worst, r.norm());
+      // Finite lengths only: a corner ~1e154 px off has an infinite norm, and a histogram
+      // bin of infinite width indexed with NaN crashed the report.
+      if (const double length = r.norm(); std::isfinite(length)) magnitudes.push_back(length), worst = std::max(worst, length);
   // Residual vectors on each image, scaled so the largest is ~40 px long.
   const double scale = worst > 0.0 ? std::pow(10.0, std::floor(std::log10(40.0 / worst))) : 1.0;
   cv::Mat coverage(detections.image_height_px, detections.image_width_px, CV_8UC3, cv::Scalar(30, 30, 30));

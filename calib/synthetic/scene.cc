@@ -1,9 +1,12 @@
 #include "calib/synthetic/scene.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <random>
+#include <set>
 
 #include "model/input_error.h"
 #include "model/io/yaml_field_reader.h"
@@ -19,6 +22,16 @@ unsigned SeedOr(const YamlFieldReader& reader, const YAML::Node& map, const std:
   if (!(seed >= 0.0 && seed <= 4294967295.0) || seed != std::floor(seed))
     reader.Fail(YamlFieldReader::Join(where, "seed"), "must be a whole number from 0 to 4294967295");
   return static_cast<unsigned>(seed);
+}
+
+// A view's name is the stem of the files written for it in the output directory: letters,
+// digits, '-', '_' and '.', not starting with '.' (a name "../x" wrote outside it).
+void CheckFileStem(const YamlFieldReader& reader, const std::string& name, const std::string& field) {
+  const bool plain = std::all_of(name.begin(), name.end(), [](unsigned char c) {
+    return std::isalnum(c) || c == '-' || c == '_' || c == '.';
+  });
+  if (name.empty() || name.size() > 100 || name[0] == '.' || !plain)
+    reader.Fail(field, "'" + name + "': must be 1-100 letters, digits, '-', '_' or '.' (not first): it names the view's files");
 }
 
 constexpr double kRad = M_PI / 180.0;
@@ -204,6 +217,7 @@ Scene LoadSceneYaml(const std::string& path) {
         const std::string where = "views[" + std::to_string(i) + "]";
         SceneView view;
         view.name = views[i]["name"] ? views[i]["name"].as<std::string>() : "view" + std::to_string(i);
+        CheckFileStem(reader, view.name, where + ".name");
         for (const auto& entry : views[i]) {
           const std::string key = entry.first.as<std::string>();
           if (key == "name") continue;
@@ -235,6 +249,7 @@ Scene LoadSceneYaml(const std::string& path) {
       const auto tilt = reader.Range(random, "tilt_deg", where, {0.0, 30.0});
       const auto roll = reader.Range(random, "roll_deg", where, {-30.0, 30.0});
       const std::string prefix = random["prefix"] ? random["prefix"].as<std::string>() : "random";
+      if (random["prefix"]) CheckFileStem(reader, prefix, where + ".prefix");
       std::mt19937 rng(SeedOr(reader, random, where, 1));
       auto uniform = [&](std::pair<double, double> r) { return std::uniform_real_distribution<double>(r.first, r.second)(rng); };
       for (int k = 0; k < static_cast<int>(count); ++k) {
@@ -256,6 +271,12 @@ Scene LoadSceneYaml(const std::string& path) {
       }
     }
     if (scene.views.empty()) reader.Fail("views", "the scene has no views (views or random_views)");
+    // Each view's image and ground truth are written as <name>.png / .json beside scene.json.
+    std::set<std::string> names;
+    for (const SceneView& view : scene.views) {
+      if (view.name == "scene") reader.Fail("views", "a view named 'scene' would overwrite scene.json");
+      if (!names.insert(view.name).second) reader.Fail("views", "two views are named '" + view.name + "'");
+    }
   } catch (const YAML::Exception& error) {
     reader.Fail("", std::string("unexpected YAML structure: ") + error.what());
   }

@@ -55,6 +55,15 @@ sed "s#\.\./#$data/#; s/warp_mm: \[3, 1\]/warp_mm: [3]/" "$data/scenes/realistic
 sed "s#\.\./#$data/#; s/jpeg_quality: 85/jpeg_quality: 120/" "$data/scenes/realistic-checkerboard.yaml" >"$f/scene-jpeg.yaml"
 printf '{"target": "%s", "image_size": [1040, 1040], "images": [{"image": "a.png", "corners": [{"id": 1, "pixel": [1e999, 2]}]}]}' \
   "$grid" >"$f/detections-huge.json"
+# Finite but absurd (its squared residual overflowed and crashed the report), and ids that
+# are not whole numbers (read as 2 and 1 before).
+sed 's/1e999/1e300/' "$f/detections-huge.json" >"$f/detections-far.json"
+# Corners found on a 50 mm board, calibrated as the 30 mm one (exit 0, a mirror 13 % too big, before).
+sed 's/"image_size"/"target_description": "aprilgrid 6 x 6 tag36h11 from id 0, 50 mm tags, spacing 0.3", "image_size"/; s/1e999/100/' \
+  "$f/detections-huge.json" >"$f/detections-other-board.json"
+sed 's/"id": 1/"id": 2.5/; s/1e999/100/' "$f/detections-huge.json" >"$f/detections-id-fraction.json"
+sed 's/"id": 1/"id": true/; s/1e999/100/' "$f/detections-huge.json" >"$f/detections-id-bool.json"
+sed "s#\.\./#$data/#; s#prefix: far#prefix: ../far#" "$data/scenes/ohte-sph-far.yaml" >"$f/scene-escape.yaml"
 printf 'x_mm,z_mm\n0,0\n1,0.1\n0.5,0.2\n2,0.3\n' >"$f/profile-back.csv"
 printf 'camera: { model: pinhole, image_size: [1000, 1000], fx: 2352, fy: 2352, cx: 499.5, cy: 499.5, k1: 0, k2: 0 }\nmirror: { profile: tabulated, rim_radius: 2, table: profile-back.csv }\npose: { m: 180, tilt_deg: [0, 0], decenter_mm: [0, 0] }\n' >"$f/sensor-table.yaml"
 readonly_dir=/proc/omnical-cannot-write  # cannot be created, even as root
@@ -113,6 +122,7 @@ row characterize "output directory cannot be created" - error -- characterize --
 row characterize "negative f-number" "$o" error -- characterize --sensor "$sensor" --f-number -4 --out "$o"
 row parallax "negative distance" "$o" error -- parallax --sensor "$sensor" --distance-mm -100 --out "$o"
 row parallax "NaN distance" "$o" error -- parallax --sensor "$sensor" --n nan --out "$o"
+row parallax "distance 1e300 mm" "$o" error -- parallax --sensor "$sensor" --distance-mm 1e300 --out "$o"
 row parallax "corrupt maps.json" "$o" error -- parallax --maps "$f/maps-corrupt" --n 7 --out "$o"
 # target / render
 row target "unknown target type" "$o.png" error -- target --spec "$f/target-type.yaml" --out "$o.png"
@@ -123,8 +133,10 @@ row render "NaN view distance" "$o" error -- render --scene "$f/scene-nan.yaml" 
 row render "missing scene" "$o" error -- render --scene "$f/none.yaml" --out "$o"
 row render "board warp with one value" "$o" error -- render --scene "$f/scene-warp.yaml" --out "$o"
 row render "JPEG quality 120" "$o" error -- render --scene "$f/scene-jpeg.yaml" --out "$o"
+row render "view prefix ../far" "$o" error -- render --scene "$f/scene-escape.yaml" --out "$o"
 row diff "missing calibration" "$o" error -- diff "$f/none" "$sensor" --out "$o"
 row diff "a sensor of another image size" "$o" error -- diff "$sensor" "$data/sensors/ohte-sph-misaligned-guess.yaml" --out "$o"
+row diff "distance 1e300 mm" "$o" error -- diff "$sensor" "$sensor" --distance-mm 1e300 --out "$o"
 # detect / calibrate
 row detect "truncated PNG" "$o.json" error -- detect --target "$grid" --images "$f/truncated" --out "$o.json"
 row detect "non-image file named .png" "$o.json" error -- detect --target "$grid" --images "$f/notimage" --out "$o.json"
@@ -136,6 +148,10 @@ row detect "wrong target spec (type)" "$o.json" error -- detect --target "$f/tar
 row detect "empty image directory" "$o.json" error -- detect --target "$grid" --images "$f/no-images" --out "$o.json"
 row calibrate "one truncated image" "$o" error -- calibrate --target "$grid" --images "$f/truncated" --sensor "$guess" --out "$o"
 row calibrate "huge corner coordinate" "$o" error -- calibrate --target "$grid" --detections "$f/detections-huge.json" --sensor "$guess" --out "$o"
+row calibrate "corners found on another board" "$o" error -- calibrate --target "$grid" --detections "$f/detections-other-board.json" --sensor "$guess" --out "$o"
+row calibrate "corner pixel 1e300" "$o" error -- calibrate --target "$grid" --detections "$f/detections-far.json" --sensor "$guess" --out "$o"
+row calibrate "corner id 2.5" "$o" error -- calibrate --target "$grid" --detections "$f/detections-id-fraction.json" --sensor "$guess" --out "$o"
+row calibrate "corner id true" "$o" error -- calibrate --target "$grid" --detections "$f/detections-id-bool.json" --sensor "$guess" --out "$o"
 row calibrate "a directory as the detections file" "$o" error -- calibrate --target "$grid" --detections "$f" --sensor "$guess" --out "$o"
 row detect "a directory as the target spec" "$o.json" error -- detect --target "$f" --images "$rendered" --out "$o.json"
 row "design ode" "a directory as the law table" "$o" error -- design ode --law table --law-table "$f" --focal-length-mm 12.5 --distance-mm 2000 --start-height-mm 155 --rim-limit-mm 30 --rho1-mm 2.4 --out "$o"
@@ -143,15 +159,23 @@ row calibrate "empty detections file" "$o" error -- calibrate --target "$grid" -
 row calibrate "negative tag size" "$o" error -- calibrate --target "$f/target-negative.yaml" --images "$rendered" --sensor "$guess" --out "$o"
 # remap / unwarp / export-central
 row remap "NaN distance" "$o" error -- remap --sensor "$sensor" --view panorama --size 64x16 --distance-mm nan --out "$o"
+row remap "n = 1e300" "$o" error -- remap --sensor "$sensor" --view panorama --size 64x16 --n 1e300 --out "$o"
 row remap "negative size" "$o" error -- remap --sensor "$sensor" --view panorama --size -64x16 --infinity --out "$o"
 row remap "huge size (1e6 x 1e6)" "$o" error -- remap --sensor "$sensor" --view panorama --size 1000000x1000000 --infinity --out "$o"
 row remap "output directory cannot be created" - error -- remap --sensor "$sensor" --view panorama --size 64x16 --infinity --out "$readonly_dir"
 row unwarp "truncated PNG" "$o.png" error -- unwarp --maps "$f/maps" --input "$f/truncated.png" --out "$o.png"
 row unwarp "non-image input" "$o.png" error -- unwarp --maps "$f/maps" --input "$f/points.csv" --out "$o.png"
 row unwarp "corrupt maps.json" "$o.png" error -- unwarp --maps "$f/maps-corrupt" --input "$omni" --out "$o.png"
+# Videos: OpenCV tried GStreamer and an image-sequence reader first, 7-11 lines before ours.
+: >"$f/empty.avi"
+head -c 3000 "$omni" >"$f/garbage.mp4"
+row unwarp "missing video" "$o.avi" error -- unwarp --maps "$f/maps" --input "$f/none.avi" --out "$o.avi"
+row unwarp "empty video" "$o.avi" error -- unwarp --maps "$f/maps" --input "$f/empty.avi" --out "$o.avi"
+row unwarp "corrupt video" "$o.avi" error -- unwarp --maps "$f/maps" --input "$f/garbage.mp4" --out "$o.avi"
 row unwarp "16-bit input" "$o.png" accepted -- unwarp --maps "$f/maps" --input "$f/deep/near000.png" --out "$o.png"
-row export-central "NaN distance" "$o" error -- export-central --sensor "$sensor" --distance-mm nan --out "$o"
-row export-central "infinite sphere radius" "$o" error -- export-central --sensor "$f/sensor-inf.yaml" --out "$o"
+row export-central "NaN distance" "$o" error -- export-central --sensor "$sensor" --model mei --distance-mm nan --out "$o"
+row export-central "distance 1e300 mm" "$o" error -- export-central --sensor "$sensor" --model mei --distance-mm 1e300 --out "$o"
+row export-central "infinite sphere radius" "$o" error -- export-central --sensor "$f/sensor-inf.yaml" --model mei --out "$o"
 # design
 row "design ode" "empty spec" "$o" error -- design ode --spec "$f/empty.yaml" --out "$o"
 row "design ode" "negative focal length" "$o" error -- design ode --law linear --focal-length-mm -12.5 --distance-mm 2000 --start-height-mm 155 --rim-limit-mm 30 --rho1-mm 2.4 --gain 2000 --offset-mm -4000 --out "$o"

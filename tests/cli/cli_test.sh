@@ -266,6 +266,8 @@ det = json.load(open(sys.argv[1])); work = sys.argv[2]
 two = dict(det); two["images"] = det["images"][:2]; json.dump(two, open(work + "/det_two.json", "w"))
 same = dict(det); same["images"] = [det["images"][0]] * 4; json.dump(same, open(work + "/det_same.json", "w"))
 size = dict(det); size["image_size"] = [1000, 1000]; json.dump(size, open(work + "/det_size.json", "w"))
+# As a file from before detections recorded their board: its ids are then checked one by one.
+undescribed = dict(det); undescribed.pop("target_description"); json.dump(undescribed, open(work + "/det_undescribed.json", "w"))
 PYBAD
 printf 'target_type: aprilgrid\ntagCols: 6\ntagRows: 6\ntagSize: 0.03\ntagSpacing: 0.3\ncodeOffset: 200\n' >"$work/other_ids.yaml"
 calibrate_error() {
@@ -287,7 +289,9 @@ calibrate_error calibrate_knots_text "--knots: expected a knot count (4..16) or 
 calibrate_error calibrate_knots_not_spline "only the spline profile has knots (profile: sphere; ask for --profile spline)" \
   --target "$grid" --detections "$work/det.json" --knots auto
 calibrate_error calibrate_one_pose "all views show the target at one pose" --target "$grid" --detections "$work/det_same.json"
-calibrate_error calibrate_spec_matches_nothing "matches no corner id" --target "$work/other_ids.yaml" --detections "$work/det.json"
+calibrate_error calibrate_spec_matches_nothing "matches no corner id" --target "$work/other_ids.yaml" --detections "$work/det_undescribed.json"
+calibrate_error calibrate_another_board "the corners were found on another board (aprilgrid 6 x 6 tag36h11 from id 0" \
+  --target "$work/other_ids.yaml" --detections "$work/det.json"
 calibrate_error calibrate_image_size "image_size: 1000 x 1000 differs from the sensor's 1040 x 1040" --target "$grid" --detections "$work/det_size.json"
 calibrate_error calibrate_unknown_block "--fix: unknown block 'focal'" --target "$grid" --detections "$work/det.json" --fix focal
 calibrate_error calibrate_unknown_tolerance "--tolerance: tolerances.B_mm: not a parameter of this sphere / pinhole sensor" \

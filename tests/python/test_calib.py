@@ -335,7 +335,7 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
     with pytest.raises(omnical.InputError) as raised:
         omnical.calibrate(TARGET, detections=detections, guess=GUESS, holdout=40)
     assert str(raised.value) == few_views and "holdout: 40 views held out" in few_views
-    with pytest.raises(omnical.InputError, match="distance_mm: must be > 0"):
+    with pytest.raises(omnical.InputError, match="distance_mm: the object distance must be > 0"):
         omnical.diff(result.sensor, result.sensor, distance_mm=0)
     with pytest.raises(omnical.InputError, match="field: expected"):
         omnical.diff(result.sensor, result.sensor, field=3)

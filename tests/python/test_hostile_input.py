@@ -126,9 +126,24 @@ def test_bad_values_that_once_slipped_through(data, tmp_path):
         omnical.calibrate(target, detections=detections, fixed=5)
     with pytest.raises(omnical.InputError, match="^detection_passes: must be 1..5"):
         omnical.calibrate(target, detections=detections, detection_passes=10**6)
+    with pytest.raises(omnical.InputError, match="the corners were found on another board"):
+        omnical.calibrate(data / "targets" / "aprilgrid-6x6-88mm.yaml", detections=detections)
     image = cv2.imread(str(data / "rendered" / "ohte-sph-near" / "near000.png"))
     with pytest.raises(omnical.InputError, match="^maps: expected"):
         omnical.unwarp(image, (np.zeros((0, 0)), np.zeros((0, 0))))
+    # Found by the 2026-11-25 fuzzing: a step of 0.01 px or 1e9 samples ran for minutes, a
+    # distance of 1e300 mm overflowed into an internal error, both distances were not named.
+    sensor = omnical.Sensor.load(data / "sensors" / "ohte-sph.yaml")
+    with pytest.raises(omnical.InputError, match="^step_px: must be 1 to 1000$"):
+        omnical.diff(sensor, sensor, step_px=0.01)
+    with pytest.raises(omnical.InputError, match="profile_samples: must be 4 to 100000$"):
+        omnical.design_fit(profile="sphere", profile_samples=10**9)
+    with pytest.raises(omnical.InputError, match="characteristic_samples: must be 2 to 100000$"):
+        omnical.design_fit(profile="sphere", characteristic_samples=10**9)
+    with pytest.raises(omnical.InputError, match="^distance_mm: the object distance must be at most 1e8 mm"):
+        omnical.export_central(sensor, distance_mm=1e300)
+    with pytest.raises(omnical.InputError, match="^n: give only one of distance_mm and n$"):
+        omnical.parallax(sensor, n=5, distance_mm=100)
 
 
 def test_ctrl_c_reaches_a_main_thread_call_while_another_thread_works(data):

@@ -164,3 +164,18 @@ def test_render_cancel_and_bad_input(scene_file, tmp_path, cli):
     assert "omega_degs" in str(error.value)
     assert str(error.value) == cli_error(cli("render", "--scene", corrupt, "--out", tmp_path / "bad"))
     assert not (tmp_path / "bad").exists()
+
+    # No scene (None reached the renderer as a null pointer: a segfault) and view names that
+    # would write outside --out, overwrite scene.json or each other.
+    with pytest.raises(TypeError, match="scene: expected an omnical.Scene, got None"):
+        omnical.render(None)
+    with pytest.raises(TypeError, match="got None"):
+        omnical.save_rendered(None, [], tmp_path / "x")
+    for name, message in [("../escape", "views\\[0\\].name: '../escape': must be"), ("scene", "overwrite scene.json"),
+                          ("side", "two views are named 'side'")]:
+        renamed = tmp_path / "renamed.yaml"
+        renamed.write_text(scene_file.read_text().replace("name: front", "name: " + name))
+        with pytest.raises(omnical.InputError, match=message):
+            omnical.Scene.load(renamed)
+        assert cli_error(cli("render", "--scene", renamed, "--out", tmp_path / "bad")).startswith(str(renamed))
+    assert not (tmp_path / "bad").exists() and not (tmp_path / "escape.png").exists()

@@ -109,12 +109,19 @@ TruthArrays TruthOf(const TargetTruth& truth) {
           std::move(visible)};
 }
 
+// pybind11 passes None as an empty holder.
+const Scene& SceneOf(const std::shared_ptr<Scene>& scene) {
+  if (!scene) throw py::type_error("scene: expected an omnical.Scene, got None");
+  return *scene;
+}
+
 py::list Render(const std::shared_ptr<Scene>& scene, int threads, py::object progress) {
+  const Scene& given = SceneOf(scene);
   RenderOptions options;
   // 0: every core, as the CLI's default.
   options.threads = threads == 0 ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency())) : threads;
   options.progress = ForwardProgress(std::move(progress));
-  std::vector<RenderedView> views = RunReleased([&] { return RenderScene(*scene, options); });
+  std::vector<RenderedView> views = RunReleased([&] { return RenderScene(given, options); });
   py::list out;
   for (RenderedView& view : views) out.append(PyRenderedView{scene, std::move(view)});
   return out;
@@ -122,6 +129,7 @@ py::list Render(const std::shared_ptr<Scene>& scene, int threads, py::object pro
 
 void SaveRendered(const std::shared_ptr<Scene>& scene, const std::vector<const PyRenderedView*>& views,
                   const py::object& out_dir, const py::object& scene_path) {
+  SceneOf(scene);
   std::vector<RenderedView> rendered;
   for (const PyRenderedView* view : views) {
     if (!view || view->scene != scene) throw InputError("views: a view was not rendered from this scene");
