@@ -331,7 +331,9 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
         !found_on.empty() && found_on != input.target.Describe())
       throw InputError(InputMessage(input.source, "target_description",
                                     "the corners were found on another board (" + found_on + ") than the target given (" +
-                                        input.target.Describe() + ")"));
+                                        input.target.Describe() +
+                                        "): detect again with it (or, if only the print's measured size changed and no "
+                                        "sensor guess was used to detect, delete target_description from the file)"));
     if (!input.guess) rim = RimOfImages(detections);
   }
   // The starting sensor: the guess (in another profile family if asked), or, with no
@@ -357,6 +359,9 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     if (options.knots > 0) start_sensor = ConvertProfile(*start_sensor, "spline", options.knots);
   }
   const Sensor& guess = *start_sensor;
+  for (double n : options.distances_n)  // in the start's rim radii: known only now, and before any fit
+    if (const std::string why = ObjectDistanceProblem(n * guess.rim_radius_mm()); !why.empty())
+      throw InputError("distances_n: " + why);
   if (detections.image_width_px != guess.image_width_px() || detections.image_height_px != guess.image_height_px())
     throw InputError(InputMessage(input.source, "image_size",
                                   std::to_string(detections.image_width_px) + " x " + std::to_string(detections.image_height_px) +
@@ -463,7 +468,15 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     fit = FitSensor(*refit_start, input.target, views.detections, views.poses, fit_options);
   }
   Sensor fit_start = refit_start ? *refit_start : guess;
-  if (passes_run > 1) screen_and_refit(fit_start);  // the corners changed
+  // The corners changed: screened again, afresh if the first screen stopped (its pass-1
+  // corners came through the design guess, and their warning no longer applies).
+  if (passes_run > 1) {
+    screen_stopped = false;
+    warnings.erase(std::remove_if(warnings.begin(), warnings.end(),
+                                  [](const CalibrationWarning& w) { return w.code == WarningCode::kBoardScreenStopped; }),
+                   warnings.end());
+    screen_and_refit(fit_start);
+  }
   // The spline's knot count by held-out folds over the views the fit kept, then the fit
   // again with that count.
   std::string knot_fallback;  // why the fitted count is not the folds' choice
@@ -611,8 +624,6 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   const std::vector<Eigen::Vector2d> field =
       FieldPixels(*fit.sensor, FieldOfCorners(*fit.sensor, fitted_views), options.predicted_error_step_px);
   const double rim_mm = guess.rim_radius_mm();  // n counts the start's (design) rim radii
-  for (double n : options.distances_n)
-    if (const std::string why = ObjectDistanceProblem(n * rim_mm); !why.empty()) throw InputError("distances_n: " + why);
 
   // Generalisation (calib/cross_validation.h): held-out views through the fitted sensor;
   // two halves' calibrations compared where the user looks.

@@ -60,12 +60,12 @@ class TagDetector {
   apriltag_detector_t* detector_;
 };
 
-// AprilTag 3 over an image (corners in its pixel-centre coordinates): the target's ids
-// only, and an id decoded twice dropped altogether (which copy is the tag is unknown).
-// A tag36h11 tag is 10 cells across with its white border, each at least a pixel to be
-// decoded.
+// A tag is decoded from about a pixel a cell at best, and the families' tags are about 10
+// cells across with their white border.
 constexpr int kMinTagImagePx = 10;
 
+// AprilTag 3 over an image (corners in its pixel-centre coordinates): the target's ids
+// only, and an id decoded twice dropped altogether (which copy is the tag is unknown).
 std::map<int, std::array<Eigen::Vector2d, 4>> DetectTags(const CalibrationTarget& target, const cv::Mat& image,
                                                          DetectionStats* stats) {
   // AprilTag 3.3 reads out of bounds on images 2 rows high or less (a segfault), and no

@@ -17,13 +17,15 @@ namespace omnical {
 
 namespace {
 
-// A whole number in int's range, or InputError naming `field` (nlohmann's get<int> would
-// truncate 2.5, wrap 2^40 and take true for 1).
+// A whole number in int's range (3.0 too: numpy's tolist() writes floats), or InputError
+// naming `field` (nlohmann's get<int> truncated 2.5, wrapped 2^40 and 2^64 - 1, and took
+// true for 1).
 int IntegerField(const nlohmann::json& value, const std::string& path, const std::string& field) {
-  if (!value.is_number_integer() || value.get<int64_t>() < std::numeric_limits<int>::min() ||
-      value.get<int64_t>() > std::numeric_limits<int>::max())
+  const double as_double = value.is_number() ? value.get<double>() : NAN;  // bool is not a number here
+  if (!(std::isfinite(as_double) && as_double == std::floor(as_double) && as_double >= std::numeric_limits<int>::min() &&
+        as_double <= std::numeric_limits<int>::max()))
     throw InputError(InputMessage(path, field, "must be a whole number of at most 10 digits (got " + value.dump() + ")"));
-  return value.get<int>();
+  return static_cast<int>(as_double);
 }
 
 std::string Number(double value) {

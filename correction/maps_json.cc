@@ -9,6 +9,7 @@
 #include "correction/map_export.h"
 #include "model/io/atomic_write.h"
 #include "model/input_error.h"
+#include "model/object_distance.h"
 
 namespace omnical {
 namespace {
@@ -175,6 +176,8 @@ MapsDescription ReadMapsDescription(const std::string& dir, RemapTable* table) {
     description.surface_json = j["surface"].dump();
     field = "v0_mm";
     settings.v0_mm = j.at("v0_mm").get<double>();
+    if (const std::string problem = ViewpointProblem(settings.v0_mm); !problem.empty())
+      throw InputError(InputMessage(path, "v0_mm", problem));
     field = "sensor.yaml";
     description.sensor_yaml = j.at("sensor").at("yaml").get<std::string>();
   } catch (const nlohmann::json::exception&) {

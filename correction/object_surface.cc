@@ -3,8 +3,6 @@
 #include <cmath>
 #include <utility>
 
-#include "model/object_distance.h"
-
 namespace omnical {
 
 const char* SurfaceKindName(ObjectSurface::Kind kind) {
@@ -26,7 +24,10 @@ std::optional<ObjectSurface::Kind> ParseSurfaceKind(const std::string& name) {
 
 std::string ObjectSurface::Check() const {
   if (kind == Kind::kInfinity) return "";
-  if (const std::string why = ObjectDistanceProblem(distance_mm); !why.empty()) return "distance_mm: " + why;
+  // Only finite here: maps.json files written before the option bound
+  // (model/object_distance.h) may hold farther distances, and still load.
+  if (!(std::isfinite(distance_mm) && distance_mm > 0.0))
+    return "distance_mm: " + std::to_string(distance_mm) + " (must be a finite distance > 0)";
   if (kind == Kind::kPlane && !(plane_normal.allFinite() && plane_normal.norm() > 1e-12)) return "plane_normal: zero or not finite";
   return "";
 }

@@ -1,7 +1,8 @@
 // Object distances the tools take, in mm (from the mirror's reference point or a view's
-// centre): finite, > 0 and at most kMaxObjectDistanceMm. Farther is infinity, which every
-// tool asks for apart (--infinity, or no distance); a distance of 1e300 mm overflowed when
-// squared and failed later with messages about other options.
+// centre): finite, > 0 and at most kMaxObjectDistanceMm, which stands for infinity where a
+// tool has no option of its own for it (remap --infinity, export-central without a
+// distance). A distance of 1e300 mm overflowed when squared and failed later with messages
+// about other options.
 #pragma once
 
 #include <cmath>
@@ -15,7 +16,7 @@ inline constexpr double kMaxObjectDistanceMm = 1e8;
 // "" when `distance_mm` is a usable object distance, else why not (without a field name).
 inline std::string ObjectDistanceProblem(double distance_mm) {
   if (!(std::isfinite(distance_mm) && distance_mm > 0.0)) return "the object distance must be > 0 and finite";
-  if (distance_mm > kMaxObjectDistanceMm) return "the object distance must be at most 1e8 mm (100 km): farther is infinity";
+  if (distance_mm > kMaxObjectDistanceMm) return "the object distance must be at most 1e8 mm (100 km; 1e8 stands for infinity)";
   return "";
 }
 

@@ -300,7 +300,7 @@ TEST(ViewRequest, ErrorsNameTheField) {
   // Finite but absurd (found by fuzzing: no map pixel was finite, reported as a 0 px error).
   EXPECT_EQ(error_of([](ViewRequest* v) { v->v0_mm = 1e300; }), "v0_mm: must lie within 1e6 mm of the mirror vertex");
   EXPECT_EQ(error_of([](ViewRequest* v) { v->n = 1e300; }),
-            "n: the object distance must be at most 1e8 mm (100 km): farther is infinity");
+            "n: the object distance must be at most 1e8 mm (100 km; 1e8 stands for infinity)");
   EXPECT_EQ(error_of([](ViewRequest* v) { v->size = "1x1"; }).rfind("size: ", 0), 0u);
   EXPECT_EQ(error_of([](ViewRequest* v) { v->view = "perspective", v->hfov_deg = 180.0; }).rfind("hfov_deg: ", 0), 0u);
   EXPECT_EQ(error_of([](ViewRequest* v) { v->elevation_deg = {-10.0, 10.0}; }).rfind("elevation_deg: ", 0), 0u);

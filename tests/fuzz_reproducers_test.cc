@@ -77,5 +77,32 @@ TEST(FuzzReproducers, ASeedOutsideTheGeneratorsRangeIsRefused) {
   }
 }
 
+// Regression (fuzzing by hand, 2026-11-25): ids were read with truncation (2.5 -> 2, 2^40
+// and 2^64 - 1 wrapped, true -> 1), and a corner at 1e300 px overflowed the report's
+// histogram (a segfault). Whole numbers written as floats (numpy's tolist()) are ids.
+TEST(FuzzReproducers, DetectionsWithOddIdsOrFarPixelsAreRefused) {
+  const std::string path = ::testing::TempDir() + "/odd-detections.json";
+  auto read_with = [&](const std::string& id, const std::string& pixel) {
+    std::ofstream(path) << R"({"target": "t.yaml", "image_size": [100, 80], "images": [{"image": "a.png", "corners": [)"
+                        << R"({"id": )" << id << R"(, "pixel": )" << pixel << "}]}]}";
+    try {
+      const DetectionSet set = ReadDetections(path);
+      return "id " + std::to_string(set.images.at(0).corners.at(0).id);
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+  };
+  const std::string not_whole = path + ": images[0] (a.png).id: must be a whole number of at most 10 digits (got ";
+  EXPECT_EQ(read_with("2.5", "[1, 2]"), not_whole + "2.5)");
+  EXPECT_EQ(read_with("true", "[1, 2]"), not_whole + "true)");
+  EXPECT_EQ(read_with("1099511627776", "[1, 2]"), not_whole + "1099511627776)");
+  EXPECT_EQ(read_with("18446744073709551615", "[1, 2]"), not_whole + "18446744073709551615)");
+  EXPECT_EQ(read_with("3.0", "[1, 2]"), "id 3");
+  EXPECT_EQ(read_with("-1", "[1, 2]"), "id -1");  // an id the target lacks: dropped by the fit, not here
+  EXPECT_EQ(read_with("3", "[1e300, 2]"), path + ": images[0] (a.png): corner 3's pixel (1e+300, 2) lies far outside the 100 x 80 image");
+  EXPECT_EQ(read_with("3", "[-100, 2]"), "id 3");  // exactly an image size outside: the bound itself
+  EXPECT_EQ(read_with("3", "[1, 2, 3]"), path + ": images[0] (a.png): corner 3's pixel must be [u, v]");
+}
+
 }  // namespace
 }  // namespace omnical

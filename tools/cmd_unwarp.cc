@@ -3,6 +3,7 @@
 // files are opened here (cv::VideoCapture/VideoWriter); the library holds the frame loop.
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
+#include <opencv2/videoio/registry.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -45,12 +46,15 @@ long UnwarpVideo(const Unwarper& unwarper, const UnwarpFlags& options, const Pro
   // Checked here, and read through FFmpeg alone: OpenCV otherwise tries GStreamer and an
   // image-sequence reader first, and each failure printed several lines before our one.
   std::error_code error;
-  if (!std::filesystem::is_regular_file(options.input, error)) throw InputError(InputMessage(options.input, "", "file not found"));
+  if (!std::filesystem::exists(options.input, error)) throw InputError(InputMessage(options.input, "", "file not found"));
+  if (!std::filesystem::is_regular_file(options.input, error))
+    throw InputError(InputMessage(options.input, "", "is not a regular file"));
   if (std::filesystem::file_size(options.input, error) == 0) throw InputError(InputMessage(options.input, "", "is empty"));
   // FFmpeg's own messages on a corrupt file ("[png @ 0x...] chunk too big") too, unless
   // the user asked for them: OpenCV reads this when it first starts FFmpeg.
   ::setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);  // AV_LOG_QUIET
-  cv::VideoCapture capture(options.input, cv::CAP_FFMPEG);
+  cv::VideoCapture capture(options.input,
+                           cv::videoio_registry::hasBackend(cv::CAP_FFMPEG) ? cv::CAP_FFMPEG : cv::CAP_ANY);
   if (!capture.isOpened()) throw InputError(InputMessage(options.input, "", "cannot be opened as a video"));
   const std::string extension = LowerExtension(options.out);
   const int fourcc = extension == ".avi" ? cv::VideoWriter::fourcc('M', 'J', 'P', 'G')

@@ -11,6 +11,7 @@
 #include "model/input_error.h"
 #include "model/io/yaml_field_reader.h"
 #include "model/io/sensor_yaml.h"
+#include "model/object_distance.h"
 
 namespace omnical {
 namespace {
@@ -50,7 +51,7 @@ Placement ReadPlacement(const SceneReader& reader, const YAML::Node& node, const
   if (node["distance_mm"] && node["distance_n"]) reader.Fail(where, "give distance_mm or distance_n, not both");
   p.distance_mm = node["distance_n"] ? rim_mm * reader.Number(node["distance_n"], where + ".distance_n")
                                      : reader.Number(node["distance_mm"], where + ".distance_mm");
-  if (!(p.distance_mm > 0.0)) reader.Fail(where + ".distance_mm", "must be > 0");
+  if (const std::string why = ObjectDistanceProblem(p.distance_mm); !why.empty()) reader.Fail(where + ".distance_mm", why);
   p.roll_deg = reader.NumberOr(node, "roll_deg", where, 0.0);
   // Two angles (about the board's x and y axes), not a range.
   if (const YAML::Node tilt = node["tilt_deg"]) {
@@ -245,7 +246,8 @@ Scene LoadSceneYaml(const std::string& path) {
       auto distance = random["distance_n"] ? reader.Range(random, "distance_n", where, {5.0, 10.0})
                                            : reader.Range(random, "distance_mm", where, {5.0 * rim, 10.0 * rim});
       if (random["distance_n"]) distance = {distance.first * rim, distance.second * rim};
-      if (!(distance.first > 0.0)) reader.Fail(where + ".distance", "must be > 0");
+      for (double end : {distance.first, distance.second})
+        if (const std::string why = ObjectDistanceProblem(end); !why.empty()) reader.Fail(where + ".distance", why);
       const auto tilt = reader.Range(random, "tilt_deg", where, {0.0, 30.0});
       const auto roll = reader.Range(random, "roll_deg", where, {-30.0, 30.0});
       const std::string prefix = random["prefix"] ? random["prefix"].as<std::string>() : "random";

@@ -5,6 +5,7 @@
 #include <type_traits>
 
 #include "model/input_error.h"
+#include "model/object_distance.h"
 
 namespace omnical {
 namespace {
@@ -17,10 +18,12 @@ bool Positive(double value) { return std::isfinite(value) && value > 0.0; }
 
 std::string CharacterizeOptions::Check() const {
   if (lens_focal_mm && !Positive(*lens_focal_mm)) return "lens_focal_mm: must be > 0";
-  if (focus_mm && !Positive(*focus_mm)) return "focus_mm: must be > 0";
+  if (focus_mm)
+    if (const std::string why = ObjectDistanceProblem(*focus_mm); !why.empty()) return "focus_mm: " + why;
   if (!Positive(f_number)) return "f_number: must be > 0";
   if (!Positive(pixel_um)) return "pixel_um: must be > 0";
-  if (!Positive(near_n)) return "near_n: must be > 0";
+  // In rim radii: 1e8 of them is infinity for any mirror of 1 mm or more.
+  if (!(Positive(near_n) && near_n <= kMaxObjectDistanceMm)) return "near_n: must be > 0 and at most 1e8";
   if (samples < 10 || samples > 100000) return "samples: must be in [10, 100000]";
   return {};
 }
