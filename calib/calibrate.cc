@@ -16,8 +16,8 @@
 #include "calib/image_file.h"
 #include "calib/rim_circle.h"
 #include "model/input_error.h"
-#include "model/object_distance.h"
 #include "model/model_registry.h"
+#include "model/object_distance.h"
 
 namespace omnical {
 namespace {
