@@ -83,9 +83,6 @@ std::string CentralExportOptions::Check() const {
     const double distance = distance_mm ? *distance_mm : *n;
     if (!std::isfinite(distance) || distance <= 0.0)
       return std::string(n ? "n" : "distance_mm") + ": the object distance must be > 0";
-    // n's distance in mm is checked once the rim radius is known (ExportCentral).
-    if (distance_mm)
-      if (const std::string why = ObjectDistanceProblem(*distance_mm); !why.empty()) return "distance_mm: " + why;
   }
   if (!(step_px >= 1.0)) return "step_px: must be >= 1";
   if (v0_mm)
@@ -105,10 +102,11 @@ CentralExportResult ExportCentral(const Sensor& sensor, const CentralExportOptio
   result.model = options.model;
   const double rim = result.rim_radius_mm = sensor.rim_radius_mm();
   result.image_width_px = sensor.image_width_px(), result.image_height_px = sensor.image_height_px();
-  if (options.distance_mm || options.n) result.surface = SphereAt(options.distance_mm ? *options.distance_mm : *options.n * rim);
-  if (options.distance_mm || options.n)
+  if (options.distance_mm || options.n) {
+    result.surface = SphereAt(options.distance_mm ? *options.distance_mm : *options.n * rim);
     if (const std::string why = ObjectDistanceProblem(result.surface.distance_mm); !why.empty())
       throw InputError(std::string(options.n ? "n" : "distance_mm") + ": " + why);
+  }
   const double reference_mm = ReferenceDistanceMm(sensor, result.surface);
   const double v0_mm = result.v0_mm = ResolveV0Mm(AnalyzeField(sensor, 360, reference_mm), reference_mm, options.v0_mm);
 

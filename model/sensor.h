@@ -12,6 +12,11 @@
 
 namespace omnical {
 
+// The mirror rim radii a sensor file may hold (model/io/sensor_yaml.h); a design fit writes
+// only those, so that what it writes loads.
+inline constexpr double kMinRimRadiusMm = 1e-3;
+inline constexpr double kMaxRimRadiusMm = 1e5;
+
 class Sensor {
  public:
   explicit Sensor(SensorModel model);

@@ -48,7 +48,9 @@ long UnwarpVideo(const Unwarper& unwarper, const UnwarpFlags& options, const Pro
   std::error_code error;
   if (!std::filesystem::exists(options.input, error)) throw InputError(InputMessage(options.input, "", "file not found"));
   if (!std::filesystem::is_regular_file(options.input, error))
-    throw InputError(InputMessage(options.input, "", "is not a regular file"));
+    throw InputError(InputMessage(options.input, "",
+                                  std::filesystem::is_directory(options.input, error) ? "is a directory, not a file"
+                                                                                       : "is not a regular file"));
   if (std::filesystem::file_size(options.input, error) == 0) throw InputError(InputMessage(options.input, "", "is empty"));
   // FFmpeg's own messages on a corrupt file ("[png @ 0x...] chunk too big") too, unless
   // the user asked for them: OpenCV reads this when it first starts FFmpeg.

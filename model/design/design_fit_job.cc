@@ -4,13 +4,14 @@
 
 #include "model/input_error.h"
 #include "model/ray_quantities.h"
+#include "model/sensor.h"
 
 namespace omnical {
 
 std::string DesignFitOptions::Check() const {
   if (const std::string why = spec.Check(); !why.empty()) return why;
   // The sensor reader's bounds (a 1e-300 mm rim was written and then refused on reading).
-  if (!(rim_radius_mm >= 1e-3 && rim_radius_mm <= 1e5)) return "rim_radius_mm: must be 1e-3 to 1e5 mm";
+  if (!(rim_radius_mm >= kMinRimRadiusMm && rim_radius_mm <= kMaxRimRadiusMm)) return "rim_radius_mm: must be 1e-3 to 1e5 mm";
   if (image_size_px < 64 || image_size_px > 20000) return "image_size_px: must be in [64, 20000]";
   // Upper bounds: 1e9 samples ran for minutes or ran out of memory.
   if (characteristic_samples < 2 || characteristic_samples > 100000) return "characteristic_samples: must be 2 to 100000";

@@ -134,8 +134,8 @@ SensorModel ReadModel(const FieldReader& reader, const YAML::Node& root) {
   const std::vector<std::string> profiles = ProfileNames();
   if (std::find(profiles.begin(), profiles.end(), profile) == profiles.end())
     reader.Fail("mirror.profile", "unknown profile '" + profile + "' (expected " + JoinChoices(profiles) + ")");
-  const double rim_mm = reader.Positive(mirror["rim_radius"], "mirror.rim_radius", 1e5);
-  if (rim_mm < 1e-3) reader.Fail("mirror.rim_radius", "must be >= 1e-3 mm");
+  const double rim_mm = reader.Positive(mirror["rim_radius"], "mirror.rim_radius", kMaxRimRadiusMm);
+  if (rim_mm < kMinRimRadiusMm) reader.Fail("mirror.rim_radius", "must be >= 1e-3 mm");
   std::optional<SensorModel> model;
   ForEachModelType([&](auto tag) {
     using Model = typename decltype(tag)::type;
