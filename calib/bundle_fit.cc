@@ -34,6 +34,31 @@ constexpr size_t kMinViews = 3;
 // A view's corners fewer than this leave its pose (6 unknowns) barely determined.
 constexpr size_t kMinCornersPerView = 4;
 
+// A corner's cost times its view's noise weight (FitOptions::view_noise_weights), read
+// through a pointer so the weights can change between solves without rebuilding the
+// problem. Owns `cost`.
+class ViewWeightedCost : public ceres::CostFunction {
+ public:
+  ViewWeightedCost(ceres::CostFunction* cost, const double* weight) : cost_(cost), weight_(weight) {
+    *mutable_parameter_block_sizes() = cost->parameter_block_sizes();
+    set_num_residuals(cost->num_residuals());
+  }
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    if (!cost_->Evaluate(parameters, residuals, jacobians)) return false;
+    const int rows = num_residuals();
+    for (int r = 0; r < rows; ++r) residuals[r] *= *weight_;
+    if (jacobians)
+      for (size_t b = 0; b < parameter_block_sizes().size(); ++b)
+        if (jacobians[b])
+          for (int k = 0; k < rows * parameter_block_sizes()[b]; ++k) jacobians[b][k] *= *weight_;
+    return true;
+  }
+
+ private:
+  std::unique_ptr<ceres::CostFunction> cost_;
+  const double* weight_;
+};
+
 // A design tolerance as a residual: noise_px x (x - design) / tolerance. Scaled by the
 // corner noise so that, next to residuals in px, it weighs as a Gaussian prior of that
 // standard deviation would: with J_prior = noise / tolerance, J^T J / noise^2 gains
@@ -111,6 +136,7 @@ class FitRun {
     result_.guess_rim_radius_mm = guess.rim_radius_mm;
     rotations_.resize(views_);
     translations_.resize(views_);
+    view_weight_.assign(views_, 1.0);  // never resized after: the costs point into it
     for (size_t v = 0; v < views_; ++v) {
       const Eigen::Quaterniond& q = initial_poses[v].camera_from_target_rotation;
       rotations_[v] = {q.x(), q.y(), q.z(), q.w()};
@@ -134,6 +160,7 @@ class FitRun {
     SolvePosesAlone();
     SolveSensorInStages();
     if (options_.robust_loss_px > 0.0 && !RejectOutliersAndRefit()) return std::move(result_);
+    WeighViewsByNoise();
     Finish();
     return std::move(result_);
   }
@@ -192,6 +219,7 @@ class FitRun {
         }
         ceres::CostFunction* cost = Cost::Create(guess_, point->second, image.corners[i].pixel, basis);
         if (options_.threads > 1) cost = evaluation_.Wrap(cost, blocks);
+        if (options_.view_noise_weights) cost = new ViewWeightedCost(cost, &view_weight_[v]);
         const ceres::ResidualBlockId id = problem_.AddResidualBlock(cost, loss_.get(), blocks);
         residuals_.push_back({v, i, std::move(functor), blocks, id});
         ++view_residuals_[v];
@@ -447,11 +475,14 @@ class FitRun {
   // coordinate with the fit's degrees of freedom (what the covariance is scaled by).
   double Statistics() {
     sum_square_ = 0.0;
+    double weighted_square = 0.0;
     inliers_ = 0;
     for (const Residual& r : residuals_) {
       double value[2];
       if (r.outlier || !(*r.functor)(r.blocks.data(), value)) continue;
-      sum_square_ += value[0] * value[0] + value[1] * value[1];
+      const double square = value[0] * value[0] + value[1] * value[1];
+      sum_square_ += square;
+      weighted_square += square * view_weight_[r.view] * view_weight_[r.view];
       ++inliers_;
     }
     std::vector<double*> all;
@@ -460,7 +491,40 @@ class FitRun {
     free_columns_ = 0;
     for (double* b : all)
       if (!problem_.IsParameterBlockConstant(b)) variable_.push_back(b), free_columns_ += problem_.ParameterBlockTangentSize(b);
-    return std::sqrt(sum_square_ / std::max(1, 2 * inliers_ - free_columns_));
+    // Unit-weight sigma: the weighted residuals' (the covariance's Jacobian is weighted too).
+    return std::sqrt(weighted_square / std::max(1, 2 * inliers_ - free_columns_));
+  }
+
+  // FitOptions::view_noise_weights: each view's noise from its own inlier residuals (its
+  // 2 n - 6 degrees of freedom), weights sigma_pooled / sigma_v, the fit repeated; twice,
+  // since each refit moves the residuals the weights came from (a third changed the
+  // realistic sets' weights by under 1 %).
+  void WeighViewsByNoise() {
+    if (!options_.view_noise_weights || !options_.refine.RefinesSensor()) return;
+    for (int round = 0; round < 2; ++round) {
+      std::vector<double> square(views_, 0.0);
+      std::vector<int> count(views_, 0);
+      for (const Residual& r : residuals_) {
+        double value[2];
+        if (r.outlier || !result_.view_left_out[r.view].empty() || !(*r.functor)(r.blocks.data(), value)) continue;
+        square[r.view] += value[0] * value[0] + value[1] * value[1];
+        ++count[r.view];
+      }
+      double pooled_square = 0.0;
+      int pooled_freedom = 0;
+      for (size_t v = 0; v < views_; ++v)
+        if (2 * count[v] > 6) pooled_square += square[v], pooled_freedom += 2 * count[v] - 6;
+      if (pooled_freedom == 0 || !(pooled_square > 0.0)) return;
+      const double pooled = std::sqrt(pooled_square / pooled_freedom);
+      for (size_t v = 0; v < views_; ++v) {
+        const int freedom = 2 * count[v] - 6;
+        const double sigma = freedom > 0 ? std::sqrt(square[v] / freedom) : pooled;
+        view_weight_[v] = sigma > 0.0 ? std::clamp(pooled / sigma, kMinViewWeight, kMaxViewWeight) : kMaxViewWeight;
+      }
+      prior_noise_px_ = std::max(1e-3, pooled);
+      Solve(Precision::kStart);
+    }
+    result_.per_view_weight = view_weight_;
   }
 
   // The last stage, to the fit's own tolerances.
@@ -649,6 +713,7 @@ class FitRun {
   ceres::Problem problem_;
   std::vector<Residual> residuals_;
   std::vector<size_t> view_residuals_;
+  std::vector<double> view_weight_;  // FitOptions::view_noise_weights; 1 otherwise
   std::vector<Prior> priors_;
   ceres::ResidualBlockId smoothness_ = nullptr;  // a free-form profile's (calib/shape_smoothness.h)
   double prior_noise_px_ = 1.0;  // the corner noise the priors are scaled by; updated between solves

@@ -66,6 +66,9 @@ struct FitResult {
   std::vector<ParameterEstimate> parameters;
   double rms_px = 0.0;  // per corner, over the inliers
   std::vector<double> per_view_rms_px;
+  // Per view: the weight its corners' residuals were multiplied by (FitOptions::
+  // view_noise_weights: pooled sigma / the view's sigma); empty when not weighted.
+  std::vector<double> per_view_weight;
   // Residual (observed - predicted... as fitted: predicted - observed) per view, per corner
   // in the order of the detections; NaN where the corner was dropped.
   std::vector<std::vector<Eigen::Vector2d>> residuals_px;
@@ -98,7 +101,8 @@ struct FitResult {
   std::vector<std::string> tolerance_notes;
   double guess_rim_radius_mm = 0.0;  // the guess's rim, for comparison with the fitted sensor's
   // Corner residuals' standard deviation per coordinate (px), from the fit's RMS and its
-  // degrees of freedom: what the covariance is scaled by.
+  // degrees of freedom: what the covariance is scaled by. With per-view weights, that of
+  // a unit-weight corner (the weighted residuals').
   double sigma_px = 0.0;
   // The board's warp when FitOptions::fit_board_warp (its std from the same covariance).
   std::optional<BoardWarpEstimate> board_warp;

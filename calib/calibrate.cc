@@ -203,6 +203,7 @@ DetectionSet CheckerboardsRefinedThrough(const CalibrationInput& input, const Ca
                                          const Sensor& through, const DetectionSet& found) {
   DetectionOptions detection;
   detection.guess = through;
+  detection.checkerboard_edges = options.checkerboard_edges;
   detection.threads = options.threads;
   detection.progress = options.progress;
   std::map<std::string, const cv::Mat*> in_memory;
@@ -225,6 +226,7 @@ FitOptions FitOptionsFor(const CalibrationInput& input, const CalibrationOptions
   if (const std::string why = fit.refine.Hold(options.fixed); !why.empty()) throw InputError(why);
   fit.robust_loss_px = options.loss_px;
   fit.fit_board_warp = options.board_warp;
+  fit.view_noise_weights = options.view_weights;
   fit.solver.max_num_iterations = options.max_iterations;
   fit.threads = options.threads;
   if (const std::string why = fit.Check(); !why.empty()) throw InputError(why);
@@ -710,6 +712,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
         w.code != WarningCode::kImageSizeDiffers && w.code != WarningCode::kCheckerboardRefused)
       record.warnings.push_back(w.text);
   for (size_t v = 0; v < usable.images.size(); ++v) record.per_view_rms_px[usable.images[v].image] = fit.per_view_rms_px[v];
+  for (size_t v = 0; v < fit.per_view_weight.size(); ++v) record.per_view_weight[usable.images[v].image] = fit.per_view_weight[v];
   record.parameters = fit.parameters;
   for (size_t v = 0; v < usable.images.size(); ++v)
     if (fit.view_left_out[v].empty()) record.poses[usable.images[v].image] = fit.poses[v];

@@ -58,6 +58,12 @@ struct CalibrationOptions {
   int holdout_views = 0;
   // Fit the board's out-of-plane warp (calib/board_warp.h) with the sensor.
   bool board_warp = false;
+  // Weight each view's corners by its own noise (FitOptions::view_noise_weights).
+  bool view_weights = false;
+  // Refine checkerboard corners by their edges through the first fit, every one
+  // (CheckerRefinement::kEdges, calib/refine_corners.h), not by cornerSubPix on grid steps
+  // of 20 px and more.
+  bool checkerboard_edges = false;
   // A spline mirror's knot count (model/spline_profile.h): 0 keeps the guess's (6 when
   // converted), 4..16, or kChooseKnots: chosen by held-out folds (calib/knot_choice.h).
   int knots = 0;

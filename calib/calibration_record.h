@@ -74,6 +74,7 @@ struct CalibrationRecord {
   std::vector<PredictedErrorSummary> predicted_error;
   std::vector<std::string> warnings;  // the texts (the codes are in CalibrationResult)
   std::map<std::string, double> per_view_rms_px;  // image -> RMS (NaN: left out)
+  std::map<std::string, double> per_view_weight;  // image -> noise weight (--view-weights; empty otherwise)
   std::vector<ParameterEstimate> parameters;      // the fit's order (read back: by name)
   std::map<std::string, TargetPose> poses;        // fitted views: image -> camera_from_target
 };

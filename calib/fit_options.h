@@ -54,6 +54,10 @@ const char* HoldName(ParameterGroup group);
 // 1.4e-6 relative (tests/bundle_fit_harness_test.cc wants 1e-6).
 ceres::Solver::Options DefaultSolverOptions();
 
+// FitOptions::view_noise_weights' bounds: a view 10x noisier than the pool still counts.
+constexpr double kMinViewWeight = 0.1;
+constexpr double kMaxViewWeight = 10.0;
+
 struct FitOptions {
   RefineOptions refine;
   double robust_loss_px = 1.0;  // robust scale in px (Cauchy, outlier removal, then Huber); 0 = plain least squares
@@ -80,6 +84,14 @@ struct FitOptions {
   // the views' RMS) is left out (robust mode): it shows something else than the other
   // views' board. Real views differ by up to 2.5x (measured on the dev set).
   double view_rms_ratio = 4.0;
+  // Per-view noise weights (variance components): after the robust fit each view's corner
+  // noise sigma_v is estimated from its own residuals (its pose's 6 degrees of freedom
+  // taken off), its corners weighted by sigma / sigma_v (sigma pooled over all views), and
+  // the fit repeated, twice. Views differ several-fold in corner noise (rendered rim views
+  // ~5x the inner ones; the real dev set's 0.18-0.50 px RMS): unweighted, the noisy ones
+  // pull the sensor as hard as sharp ones and the covariance, scaled by one pooled sigma,
+  // misstates both. The weights are clamped to [kMinViewWeight, kMaxViewWeight].
+  bool view_noise_weights = false;
   // Design tolerances: one standard deviation of a Gaussian prior around the guess's value,
   // per parameter name as FitResult names them (fx_px, cx_px, k1, m_mm, decenter_x_mm,
   // A_mm, ...) or a pair: tilt_deg, decenter_mm, principal_point_px, focal_px. They pull

@@ -31,9 +31,10 @@ const Sensor* GuessFor(const cv::Mat& grey, const DetectionOptions& options) {
 ImageDetections Refined(const CalibrationTarget& target, const cv::Mat& grey, const Sensor* guess,
                         const DetectionOptions& options, const ImageDetections& found) {
   const bool checkerboard = target.type() == CalibrationTarget::Type::kCheckerboard;
-  if (!options.refine && !(checkerboard && options.refine_checkerboards)) return found;
+  if (!options.refine && !(checkerboard && (options.refine_checkerboards || options.checkerboard_edges))) return found;
   return RefineCorners(target, grey, guess, found, nullptr,
-                       checkerboard && !options.refine_checkerboards ? kMinRefinedCheckerStepPx : 0.0);
+                       checkerboard && !options.refine_checkerboards ? kMinRefinedCheckerStepPx : 0.0,
+                       options.checkerboard_edges ? CheckerRefinement::kEdges : CheckerRefinement::kSubPixel);
 }
 
 void DetectOne(const CalibrationTarget& target, const cv::Mat& grey, const DetectionOptions& options, OneImage* out) {

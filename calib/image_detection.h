@@ -28,6 +28,8 @@ struct DetectionOptions {
   // Every checkerboard corner, small squares too (on the real Mei images it made the
   // halves of the set differ more: calib/refine_corners.h).
   bool refine_checkerboards = false;
+  // With a guess: checkerboard corners refined by their edges, every one (calib/refine_corners.h).
+  bool checkerboard_edges = false;
   bool rim_circles = false;
   // false: with a guess, search its virtual views only (images the omni image's search
   // already missed: a second pass through a fitted sensor).

@@ -48,6 +48,92 @@ bool SubPixel(const cv::Mat& image, const Eigen::Vector2d& start, double window_
 
 double Sample(const cv::Mat& image, const Eigen::Vector2d& at) { return Bilinear<uint8_t>(image, at.x(), at.y()); }
 
+// An edge profile: the image along base + s * normal at kProfileSamples values of s from
+// from_px to to_px (in that order). False where it leaves the image.
+constexpr int kProfileSamples = 41;
+struct EdgeProfile {
+  double from_px, to_px;
+  double values[kProfileSamples];
+  double Step() const { return (to_px - from_px) / (kProfileSamples - 1); }
+  double S(int k) const { return from_px + Step() * k; }
+  // The mean over the samples with s in [low_px, high_px].
+  double Mean(double low_px, double high_px) const {
+    double sum = 0.0;
+    int count = 0;
+    for (int k = 0; k < kProfileSamples; ++k)
+      if (S(k) >= low_px && S(k) <= high_px) sum += values[k], ++count;
+    return sum / std::max(1, count);
+  }
+  // Where the profile crosses `level`, nearest to s = 0 (not finite if it never does).
+  double CrossingNearestZero(double level) const {
+    double best = HUGE_VAL;
+    for (int k = 0; k + 1 < kProfileSamples; ++k) {
+      const double a = values[k] - level, b = values[k + 1] - level;
+      if (a * b > 0.0 || a == b) continue;
+      const double s = from_px + Step() * (k + a / (a - b));
+      if (std::abs(s) < std::abs(best)) best = s;
+    }
+    return best;
+  }
+};
+bool SampleProfile(const cv::Mat& image, const Eigen::Vector2d& base, const Eigen::Vector2d& normal, double from_px,
+                   double to_px, EdgeProfile* profile) {
+  profile->from_px = from_px;
+  profile->to_px = to_px;
+  for (int k = 0; k < kProfileSamples; ++k)
+    if (profile->values[k] = Sample(image, base + profile->S(k) * normal); !std::isfinite(profile->values[k])) return false;
+  return true;
+}
+
+// Crossings (t along an edge, s across it) fitted by the line s = a + b t (least squares);
+// scatter: their RMS about it.
+struct EdgeLineFit {
+  double a = 0.0, b = 0.0, scatter = 0.0;
+};
+EdgeLineFit FitEdgeLine(const std::vector<double>& ts, const std::vector<double>& ss) {
+  double mt = 0, ms = 0, stt = 0, sts = 0;
+  for (size_t i = 0; i < ts.size(); ++i) mt += ts[i], ms += ss[i];
+  mt /= ts.size();
+  ms /= ts.size();
+  for (size_t i = 0; i < ts.size(); ++i) stt += (ts[i] - mt) * (ts[i] - mt), sts += (ts[i] - mt) * (ss[i] - ms);
+  EdgeLineFit fit;
+  fit.b = sts / stt;
+  fit.a = ms - fit.b * mt;
+  for (size_t i = 0; i < ts.size(); ++i) fit.scatter += std::pow(ss[i] - fit.a - fit.b * ts[i], 2);
+  fit.scatter = std::sqrt(fit.scatter / ts.size());
+  return fit;
+}
+
+// Crossings fitted by the parabola s = a + b t + c t^2 (least squares): a and b the curve's
+// offset and slope at t = 0; scatter: their RMS about it.
+EdgeLineFit FitEdgeCurve(const std::vector<double>& ts, const std::vector<double>& ss) {
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d right = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < ts.size(); ++i) {
+    const Eigen::Vector3d row(1.0, ts[i], ts[i] * ts[i]);
+    normal += row * row.transpose();
+    right += row * ss[i];
+  }
+  const Eigen::Vector3d abc = normal.ldlt().solve(right);
+  EdgeLineFit fit;
+  fit.a = abc[0];
+  fit.b = abc[1];
+  for (size_t i = 0; i < ts.size(); ++i) fit.scatter += std::pow(ss[i] - abc[0] - abc[1] * ts[i] - abc[2] * ts[i] * ts[i], 2);
+  fit.scatter = std::sqrt(fit.scatter / ts.size());
+  return fit;
+}
+
+// Where point[0] + u direction[0] meets point[1] + v direction[1] (unit directions); false
+// when the sine of their angle is under min_sine.
+bool IntersectLines(const Eigen::Vector2d (&point)[2], const Eigen::Vector2d (&direction)[2], double min_sine,
+                    Eigen::Vector2d* at) {
+  Eigen::Matrix2d m;
+  m << direction[0], -direction[1];
+  if (std::abs(m.determinant()) < min_sine) return false;
+  *at = point[0] + (m.inverse() * (point[1] - point[0])).x() * direction[0];
+  return true;
+}
+
 // Where an edge crosses the profile base + s * normal, s from -inside_px (ink) to
 // +outside_px (paper): the crossing of the level halfway between the ink level and the
 // paper plateau (unbiased for any symmetric blur), nearest to s = 0. The ink level comes
@@ -55,28 +141,12 @@ double Sample(const cv::Mat& image, const Eigen::Vector2d& at) { return Bilinear
 // own. False on a weak or missing edge.
 bool EdgeCrossing(const cv::Mat& image, const Eigen::Vector2d& base, const Eigen::Vector2d& normal, double inside_px,
                   double outside_px, double ink, double* crossing) {
-  constexpr int kSamples = 41;
-  double values[kSamples], paper = 0.0;
-  int plateau = 0;
-  const double step = (inside_px + outside_px) / (kSamples - 1);
-  for (int k = 0; k < kSamples; ++k) {
-    const double s = -inside_px + step * k;
-    values[k] = Sample(image, base + s * normal);
-    if (!std::isfinite(values[k])) return false;
-    if (s >= 0.6 * outside_px) paper += values[k], ++plateau;
-  }
-  paper /= std::max(1, plateau);
+  EdgeProfile profile;
+  if (!SampleProfile(image, base, normal, -inside_px, outside_px, &profile)) return false;
+  const double paper = profile.Mean(0.6 * outside_px, HUGE_VAL);
   if (paper - ink < 20.0) return false;
-  const double level = 0.5 * (ink + paper);
-  double best = HUGE_VAL;
-  for (int k = 0; k + 1 < kSamples; ++k) {
-    const double a = values[k] - level, b = values[k + 1] - level;
-    if (a * b > 0.0 || a == b) continue;
-    const double s = -inside_px + step * (k + a / (a - b));
-    if (std::abs(s) < std::abs(best)) best = s;
-  }
-  *crossing = best;
-  return std::isfinite(best);
+  *crossing = profile.CrossingNearestZero(0.5 * (ink + paper));
+  return std::isfinite(*crossing);
 }
 
 // An aprilgrid corner is the convex corner of a black square on the white gap, where a
@@ -114,29 +184,16 @@ bool RefineSquareCorner(const cv::Mat& image, const Eigen::Vector2d& start, cons
         if (double s; EdgeCrossing(image, corner + t * edge[e], normal, 0.8 * cell_px, 1.6 * cell_px, ink, &s))
           ts.push_back(t), ss.push_back(s);
       if (ts.size() < 4) return false;
-      // s = a + b t by least squares.
-      double mt = 0, ms = 0, stt = 0, sts = 0;
-      for (size_t i = 0; i < ts.size(); ++i) mt += ts[i], ms += ss[i];
-      mt /= ts.size();
-      ms /= ts.size();
-      for (size_t i = 0; i < ts.size(); ++i) stt += (ts[i] - mt) * (ts[i] - mt), sts += (ts[i] - mt) * (ss[i] - ms);
-      const double b = sts / stt, a = ms - b * mt;
+      const EdgeLineFit line = FitEdgeLine(ts, ss);
       // A straight edge fits its crossings to a small fraction of a cell; crossings
       // scattered over the profile mean the start was off the corner (another edge, the
       // data bits): keep the detector's point.
-      double scatter = 0.0;
-      for (size_t i = 0; i < ts.size(); ++i) scatter += std::pow(ss[i] - a - b * ts[i], 2);
       const double profiles = (7.0 - 0.5) * cell_px / 0.5;
-      if (std::sqrt(scatter / ts.size()) > 0.1 * cell_px || ts.size() < 0.6 * profiles) return false;
-      point[e] = corner + a * normal;
-      direction[e] = (edge[e] + b * normal).normalized();
+      if (line.scatter > 0.1 * cell_px || ts.size() < 0.6 * profiles) return false;
+      point[e] = corner + line.a * normal;
+      direction[e] = (edge[e] + line.b * normal).normalized();
     }
-    // point[0] + u direction[0] = point[1] + v direction[1]
-    Eigen::Matrix2d m;
-    m << direction[0], -direction[1];
-    if (std::abs(m.determinant()) < 0.2) return false;  // edges nearly parallel: not a corner
-    const Eigen::Vector2d uv = m.inverse() * (point[1] - point[0]);
-    corner = point[0] + uv.x() * direction[0];
+    if (!IntersectLines(point, direction, 0.2, &corner)) return false;  // edges nearly parallel: not a corner
     edge[0] = direction[0];
     edge[1] = direction[1];
   }
@@ -145,15 +202,79 @@ bool RefineSquareCorner(const cv::Mat& image, const Eigen::Vector2d& start, cons
   return true;
 }
 
+// Where the edge between two squares crosses base + s * normal, s in [-half_px, half_px]:
+// the crossing of the level halfway between the plateaus at both ends (the outer 40 %),
+// nearest to s = 0. False on a weak edge (under 20 grey levels).
+bool JunctionEdgeCrossing(const cv::Mat& image, const Eigen::Vector2d& base, const Eigen::Vector2d& normal,
+                          double half_px, double* crossing) {
+  EdgeProfile profile;
+  if (!SampleProfile(image, base, normal, -half_px, half_px, &profile)) return false;
+  const double low = profile.Mean(-HUGE_VAL, -0.6 * half_px), high = profile.Mean(0.6 * half_px, HUGE_VAL);
+  if (std::abs(high - low) < 20.0) return false;
+  *crossing = profile.CrossingNearestZero(0.5 * (low + high));
+  return std::isfinite(*crossing);
+}
+
+// CheckerRefinement::kEdges (calib/refine_corners.h): a checkerboard corner is where two
+// edges cross, each running through the corner between two squares (its contrast flips
+// there), located along profiles across it on both sides, fitted by a parabola, and the
+// tangents at the corner intersected; twice, the second time along the fitted tangents.
+bool RefineCheckerJunction(const cv::Mat& image, const Eigen::Vector2d& start, const std::vector<Eigen::Vector2d>& neighbours,
+                           double square_px, Eigen::Vector2d* refined) {
+  if (neighbours.size() < 2 || square_px < 8.0) return false;
+  // The two grid lines: towards the first neighbour, and the neighbour most across it.
+  Eigen::Vector2d line[2] = {(neighbours[0] - start).normalized(), Eigen::Vector2d::Zero()};
+  double across = 0.0;
+  for (size_t k = 1; k < neighbours.size(); ++k) {
+    const Eigen::Vector2d d = (neighbours[k] - start).normalized();
+    const double sine = std::abs(line[0].x() * d.y() - line[0].y() * d.x());
+    if (sine > across) across = sine, line[1] = d;
+  }
+  if (across < 0.5) return false;  // squares sheared beyond 30 deg: not a junction we can read
+  Eigen::Vector2d corner = start;
+  for (int pass = 0; pass < 2; ++pass) {
+    Eigen::Vector2d point[2], direction[2];
+    for (int e = 0; e < 2; ++e) {
+      const Eigen::Vector2d normal(-line[e].y(), line[e].x());
+      std::vector<double> ts, ss;
+      for (double t = 0.25 * square_px; t <= 0.85 * square_px; t += 0.5)
+        for (double sign : {-1.0, 1.0}) {
+          // Profiles stay between the other grid line and the next edge parallel to this one.
+          const double half_px = std::min(0.45 * square_px, 0.7 * t * across);
+          if (double s; JunctionEdgeCrossing(image, corner + sign * t * line[e], normal, half_px, &s))
+            ts.push_back(sign * t), ss.push_back(s);
+        }
+      const double profiles = 2.0 * (0.85 - 0.25) * square_px / 0.5;
+      if (ts.size() < 0.6 * profiles) return false;
+      const EdgeLineFit fit = FitEdgeCurve(ts, ss);
+      // Crossings scattered over the profile: the start was off the junction, or the edge
+      // is not there (the rim, an occluder): keep the detector's point.
+      if (fit.scatter > 0.05 * square_px) return false;
+      point[e] = corner + fit.a * normal;
+      direction[e] = (line[e] + fit.b * normal).normalized();
+    }
+    if (!IntersectLines(point, direction, 0.5, &corner)) return false;
+    line[0] = direction[0];
+    line[1] = direction[1];
+  }
+  if ((corner - start).norm() > 0.25 * square_px) return false;
+  *refined = corner;
+  return true;
+}
+
 // Refines one corner in `image` given its neighbours' positions there. Returns false
-// where the detector's position is kept.
+// where the detector's position is kept. `by_edges`: a checkerboard's by its edges (only
+// in a patch through a guess, where they are nearly straight; on the omni image they
+// curve).
 bool RefineInImage(const CalibrationTarget& target, const cv::Mat& image, const Eigen::Vector2d& start,
-                   const std::vector<Eigen::Vector2d>& neighbours, Eigen::Vector2d* refined) {
+                   const std::vector<Eigen::Vector2d>& neighbours, bool by_edges, Eigen::Vector2d* refined) {
   double distance = HUGE_VAL;
   for (const Eigen::Vector2d& n : neighbours) distance = std::min(distance, (n - start).norm());
   if (!std::isfinite(distance)) return false;
-  if (target.type() == CalibrationTarget::Type::kCheckerboard)
+  if (target.type() == CalibrationTarget::Type::kCheckerboard) {
+    if (by_edges) return RefineCheckerJunction(image, start, neighbours, distance, refined);
     return SubPixel(image, start, 0.4 * distance, refined);  // 0.4 square keeps off the next corners' edges
+  }
   // tagStandard41h12 has data bits outside its black square: no clean edge profile there.
   if (target.family() != "tag36h11" || neighbours.size() != 2) return false;
   const Eigen::Vector2d towards[2] = {neighbours[0] - start, neighbours[1] - start};
@@ -161,15 +282,17 @@ bool RefineInImage(const CalibrationTarget& target, const cv::Mat& image, const 
 }
 
 // The margin a refinement needs around the corner, in neighbour distances.
-double ReachOf(const CalibrationTarget& target) {
-  return target.type() == CalibrationTarget::Type::kCheckerboard ? 0.5 : (7.0 + 0.8) / 8.0;
+double ReachOf(const CalibrationTarget& target, CheckerRefinement checker_refinement) {
+  if (target.type() != CalibrationTarget::Type::kCheckerboard) return (7.0 + 0.8) / 8.0;
+  return checker_refinement == CheckerRefinement::kEdges ? 0.85 + 0.45 : 0.5;
 }
 
 }  // namespace
 
 ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& grey, const Sensor* guess,
                               const ImageDetections& detections, CornerRefinementStats* stats,
-                              double min_checker_step_px) {
+                              double min_checker_step_px, CheckerRefinement checker_refinement) {
+  const bool by_edges = guess && checker_refinement == CheckerRefinement::kEdges;
   CornerRefinementStats local;
   std::map<int, Eigen::Vector2d> by_id;
   for (const CornerObservation& c : detections.corners) by_id[c.id] = c.pixel;
@@ -192,7 +315,9 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
     bool moved = false;
     Eigen::Vector2d refined;
     bool small_square = false;
-    if (target.type() == CalibrationTarget::Type::kCheckerboard && min_checker_step_px > 0.0) {
+    // Small squares: left to the detector for cornerSubPix (its window holds too few
+    // pixels there), not for the edge fits (they run over a magnified square).
+    if (target.type() == CalibrationTarget::Type::kCheckerboard && min_checker_step_px > 0.0 && !by_edges) {
       double omni_step_px = HUGE_VAL;
       for (int n : neighbour_ids)
         if (by_id.count(n)) omni_step_px = std::min(omni_step_px, (by_id[n] - corner.pixel).norm());
@@ -204,7 +329,7 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
       std::vector<Eigen::Vector2d> neighbours;
       for (int n : neighbour_ids)
         if (by_id.count(n)) neighbours.push_back(by_id[n]);
-      moved = RefineInImage(target, grey, corner.pixel, neighbours, &refined);
+      moved = RefineInImage(target, grey, corner.pixel, neighbours, /*by_edges=*/false, &refined);
     } else if (rays.count(corner.id)) {
       const auto& [origin, direction] = rays[corner.id];
       // Patch focal length: kMagnification x the omni image's px per rad around this ray,
@@ -248,13 +373,13 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
       for (Eigen::Vector2d& n : neighbours) n *= focal;
       // Bounded: a corner whose neighbours sit absurdly far is not refined.
       if (omni_px_per_rad > 0.0 && std::isfinite(distance) && distance < 2000.0) {
-        const int half_size = static_cast<int>(std::ceil(ReachOf(target) * distance)) + 4;
+        const int half_size = static_cast<int>(std::ceil(ReachOf(target, checker_refinement) * distance)) + 4;
         const VirtualView patch(*guess, frame, origin, focal, 2 * half_size + 1, 2 * half_size + 1, depth_mm);
         const cv::Mat image = patch.Resample(grey, cv::INTER_CUBIC);
         const Eigen::Vector2d centre(half_size, half_size);
         for (Eigen::Vector2d& n : neighbours) n += centre;
         Eigen::Vector2d refined_patch;
-        moved = RefineInImage(target, image, centre, neighbours, &refined_patch) && patch.ToOmni(refined_patch, &refined);
+        moved = RefineInImage(target, image, centre, neighbours, by_edges, &refined_patch) && patch.ToOmni(refined_patch, &refined);
       }
     }
     if (moved) {

@@ -46,10 +46,25 @@ struct CornerRefinementStats {
 // (calib/checkerboard_candidates.cc judges corners by it from the same step on).
 constexpr double kMinRefinedCheckerStepPx = 20.0;
 
+// How checkerboard corners are refined in patches through a guess. kSubPixel: cornerSubPix
+// on the junction (grid steps of min_checker_step_px and more). kEdges: every corner, its
+// two edges located along profiles across them on both sides of the junction (mid-level
+// crossings, unbiased for a blur symmetric across an edge) from 0.25 to 0.85 of a square,
+// each fitted by a parabola (a bent board's edge, or one through an imperfect guess, is a
+// curve: a line would cut its chord, off the corner), the tangents at the corner
+// intersected. cornerSubPix's gradient window is biased where the blur varies across it:
+// in a patch resampled from near the rim the omni image's blur is stretched more on the
+// outer side, and OpenCV's own corners (kept on small squares) sat 0.02-0.09 px inwards
+// per view on the realistic checkerboard renders, enough to put fx 11 std off on a
+// re-rendered set (docs/calibrate.md, "Checkerboard corners by their edges").
+enum class CheckerRefinement { kSubPixel, kEdges };
+
 // Checkerboard corners whose nearest detected grid neighbour lies closer than
-// min_checker_step_px in the omni image keep the detector's position (counted as kept).
+// min_checker_step_px in the omni image keep the detector's position (counted as kept),
+// except with kEdges through a guess.
 ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& grey, const Sensor* guess,
                               const ImageDetections& detections, CornerRefinementStats* stats = nullptr,
-                              double min_checker_step_px = 0.0);
+                              double min_checker_step_px = 0.0,
+                              CheckerRefinement checker_refinement = CheckerRefinement::kSubPixel);
 
 }  // namespace omnical

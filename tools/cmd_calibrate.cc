@@ -124,6 +124,12 @@ Command CalibrateCommand() {
             sub.add_flag("--board-warp", library.board_warp,
                          "Also fit the board's out-of-plane warp (a paraboloid along each board axis, mm at the centre; "
                          "paper boards bend)");
+            sub.add_flag("--checkerboard-edges", library.checkerboard_edges,
+                         "Refine checkerboard corners through the first fit by their edges (curves fitted across both "
+                         "sides of each junction), every corner, instead of cornerSubPix on squares of 20 px and more");
+            sub.add_flag("--view-weights", library.view_weights,
+                         "Weight each view's corners by its own noise, estimated from its residuals (views as sharp "
+                         "as they are noisy: blur and JPEG near the rim); calibration.json per_view_weight");
             sub.add_option("--knots", options->knots,
                            "With --profile spline: the mirror's knot count (4..16), or auto: chosen by held-out "
                            "folds of the views (calibration.json knot_choice)");

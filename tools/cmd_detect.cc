@@ -34,6 +34,9 @@ Command DetectCommand() {
             sub.add_flag("--refine-checkerboard", options->refine_checkerboards,
                          "Refine every checkerboard corner with cornerSubPix, on squares under 20 px too (sharper on "
                          "clean images; on the real Mei images the set's halves then differ more)");
+            sub.add_flag("--checkerboard-edges", options->checkerboard_edges,
+                         "With --sensor: refine every checkerboard corner by its edges (curves fitted across both sides "
+                         "of the junction in a patch through the sensor) instead of cornerSubPix");
             sub.add_option("--threads", options->threads, "Worker threads")->check(CLI::Range(1, 256))->capture_default_str();
             return [=, &context]() {
               const CalibrationTarget target = CalibrationTarget::FromYaml(*spec);

@@ -17,7 +17,11 @@
 # rim, 1 cut); checkerboard found 97 % (557 of 570: 97.7 %; 13 rim corners not found), used
 # 97 % (554: 97.2 %; 3 cut). Short of the 99 % wanted. Found corners within 0.3 px RMS of
 # the truth.
-# Usage: realistic_render_test.sh OMNICAL_BINARY SOURCE_DIR [aprilgrid|checkerboard]
+# checkerboard-edges: the checkerboard set with --checkerboard-edges (every corner refined by
+# its edges through the first fit, calib/refine_corners.h): measured within 1.9 std (k1;
+# fx 1.5), 556 used, refined corners 0.068 px RMS from the truth (0.116 without): bounded at
+# 0.1 px.
+# Usage: realistic_render_test.sh OMNICAL_BINARY SOURCE_DIR [aprilgrid|checkerboard|checkerboard-edges]
 set -u
 omnical=$1
 source_dir=$(cd "$2" && pwd)
@@ -25,22 +29,25 @@ kind=${3:-aprilgrid}
 data=$source_dir/datasets-synthetic
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-set_dir=$data/rendered/realistic-$kind
+extra=() corner_bound=0.3
 case $kind in
   aprilgrid) target=$data/targets/aprilgrid-6x6-30mm.yaml found_floor=0.98 used_floor=0.96 ;;
   checkerboard) target=$data/targets/checkerboard-8x6-30mm.yaml found_floor=0.97 used_floor=0.97 ;;
+  checkerboard-edges) target=$data/targets/checkerboard-8x6-30mm.yaml found_floor=0.97 used_floor=0.97
+    kind=checkerboard extra=(--checkerboard-edges) corner_bound=0.1 ;;
   *) echo "FAIL: unknown set kind '$kind'"; exit 1 ;;
 esac
+set_dir=$data/rendered/realistic-$kind
 
 "$omnical" -q calibrate --target "$target" --images "$set_dir" \
-  --sensor "$data/sensors/ohte-sph-misaligned-guess.yaml" --board-warp --threads 2 --out "$work/cal" 2>/dev/null ||
+  --sensor "$data/sensors/ohte-sph-misaligned-guess.yaml" --board-warp --threads 2 "${extra[@]}" --out "$work/cal" 2>/dev/null ||
   { echo "FAIL: calibrate exited $?"; exit 1; }
 
-OMNICAL_CLI_TESTS=$source_dir/tests/cli python3 - "$set_dir" "$work/cal" "$found_floor" "$used_floor" <<'PY'
+OMNICAL_CLI_TESTS=$source_dir/tests/cli python3 - "$set_dir" "$work/cal" "$found_floor" "$used_floor" "$corner_bound" <<'PY'
 import glob, json, math, os, sys
 sys.path.insert(0, os.environ["OMNICAL_CLI_TESTS"])
 import sphere_truth
-render, cal, found_floor, used_floor = sys.argv[1], sys.argv[2], float(sys.argv[3]), float(sys.argv[4])
+render, cal, found_floor, used_floor, corner_bound = sys.argv[1], sys.argv[2], float(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5])
 failed = []
 def check(ok, what):
     print(("ok   " if ok else "FAIL ") + what)
@@ -80,6 +87,6 @@ check(found >= found_floor * visible, "found %d of %d visible corners (%.1f %%, 
       (found, visible, 100.0 * found / visible, 100 * found_floor, found - len(squares)))
 check(used >= used_floor * visible, "the fit used %d of %d visible corners (%.1f %%, floor %g %%; %d cut)" %
       (used, visible, 100.0 * used / visible, 100 * used_floor, result["outliers"]))
-check(rms < 0.3, "refined corners %.3f px RMS from the ground truth (< 0.3)" % rms)
+check(rms < corner_bound, "refined corners %.3f px RMS from the ground truth (< %g)" % (rms, corner_bound))
 sys.exit(1 if failed else 0)
 PY

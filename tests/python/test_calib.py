@@ -341,6 +341,28 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
         omnical.diff(result.sensor, result.sensor, field=3)
 
 
+def test_view_weights_equal_cli(runs, tmp_path):
+    """view_weights (--view-weights): both front ends, the same weights, one per fitted view,
+    each the pooled noise over the view's own (so weight x the view's RMS is nearly the same for
+    every view: the RMS is per corner, the noise from the 2 n - 6 degrees of freedom a pose
+    leaves, and the weights come from the residuals before the last refit: 15 %)."""
+    detections = runs.out / "cli" / "detections.json"
+    result, done = beside_cli(
+        ["-q", "calibrate", "--target", TARGET, "--detections", detections, "--sensor", GUESS, "--view-weights",
+         "--out", tmp_path / "cli"],
+        lambda: omnical.calibrate(TARGET, detections=detections, guess=GUESS, view_weights=True))
+    assert done.returncode == 0, done.stderr
+    cli = json.loads((tmp_path / "cli" / "calibration.json").read_text())
+    assert_json_equal(json.loads(result.to_json()), cli)
+    weights = result.per_view_weight
+    assert set(weights) == set(cli["per_view_weight"]) == set(result.per_view_rms_px) and len(weights) >= 3
+    counts = {view.image: len(view) for view in omnical.Detections.load(detections).images}
+    scaled = [weights[v] * result.per_view_rms_px[v] * (2 * counts[v] / (2 * counts[v] - 6)) ** 0.5 for v in weights]
+    assert max(scaled) < 1.15 * min(scaled), scaled
+    assert not omnical.calibrate(TARGET, detections=detections, guess=GUESS).per_view_weight
+    assert "per_view_weight" not in json.loads((runs.out / "cli" / "calibration.json").read_text())
+
+
 # --- detect ------------------------------------------------------------------------------
 
 def test_detect_equals_cli_and_arrays_equal_paths(few, tmp_path):
@@ -380,10 +402,13 @@ def test_detect_equals_cli_and_arrays_equal_paths(few, tmp_path):
 
 
 def test_detect_refine_options_equal_cli(tmp_path):
-    """refine=False (--no-refine) on an aprilgrid; refine_checkerboards (--refine-checkerboard) on a checkerboard."""
+    """refine=False (--no-refine) on an aprilgrid; refine_checkerboards (--refine-checkerboard) and
+    checkerboard_edges with a guess (--sensor --checkerboard-edges) on a checkerboard."""
+    boards = DATA / "rendered" / "ohte-sph-checkerboard-near"
     cases = [(TARGET, IMAGES / "near005.png", {"refine": False}, ["--no-refine"]),
-             (CHECKERBOARD, DATA / "rendered" / "ohte-sph-checkerboard-near" / "cb000.png",
-              {"refine_checkerboards": True}, ["--refine-checkerboard"])]
+             (CHECKERBOARD, boards / "cb000.png", {"refine_checkerboards": True}, ["--refine-checkerboard"]),
+             (CHECKERBOARD, boards / "cb000.png", {"guess": boards / "sensor.yaml", "checkerboard_edges": True},
+              ["--sensor", boards / "sensor.yaml", "--checkerboard-edges"])]
     for index, (target, image, kwargs, flags) in enumerate(cases):
         directory = tmp_path / str(index)
         directory.mkdir()

@@ -201,6 +201,8 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
         "Covariance of the free sensor parameters (poses marginalised), float64 (K, K), in covariance_names' order and "
         "the parameters' units.");
   field("per_view_rms_px", &CalibrationRecord::per_view_rms_px, "dict image -> RMS of its corners (px; NaN: left out).");
+  field("per_view_weight", &CalibrationRecord::per_view_weight,
+        "dict image -> the weight its corners had in the fit (view_weights=True: pooled noise / the view's); empty otherwise.");
   cls.def_property_readonly(
       "correlation", [record](const Holder& holder) { return Eigen::MatrixXd(CorrelationOf(record(holder).covariance)); },
       "The covariance as correlations, float64 (K, K), unit diagonal, in covariance_names' order.");
@@ -300,7 +302,8 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
 }
 
 PyDetections Detect(const py::object& target_arg, const py::object& images_arg, const py::object& guess, bool refine,
-                    bool refine_checkerboards, bool rim_circles, int threads, py::object progress) {
+                    bool refine_checkerboards, bool checkerboard_edges, bool rim_circles, int threads,
+                    py::object progress) {
   const PyTarget target = TargetOf(target_arg);
   const ImageInput input = ImagesOf(images_arg);
   DetectionOptions options;
@@ -308,6 +311,7 @@ PyDetections Detect(const py::object& target_arg, const py::object& images_arg, 
   options.guess = GuessOf(guess, &guess_name, nullptr);
   options.refine = refine;
   options.refine_checkerboards = refine_checkerboards;
+  options.checkerboard_edges = checkerboard_edges;
   options.rim_circles = rim_circles;
   options.threads = ThreadsOf(threads);
   options.progress = ForwardProgress(std::move(progress));
@@ -355,6 +359,7 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
                         const py::object& tolerances, const std::vector<double>& distances_mm,
                         const std::vector<double>& distances_n, double max_predicted_error_px, double rim_field_deg,
                         int holdout, bool cross_validate, double cross_validation_distance_mm, bool board_warp,
+                        bool view_weights, bool checkerboard_edges,
                         const py::object& knots, py::object progress) {
   CalibrationInput input;
   PyTarget target = TargetOf(target_arg);
@@ -394,6 +399,8 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
   options.rim_field_deg = rim_field_deg;
   options.holdout_views = holdout;
   options.board_warp = board_warp;
+  options.view_weights = view_weights;
+  options.checkerboard_edges = checkerboard_edges;
   if (py::isinstance<py::str>(knots)) {
     options.knots = ParseKnotCount(knots.cast<std::string>(), "knots");
   } else if (py::isinstance<py::int_>(knots) && !py::isinstance<py::bool_>(knots)) {
@@ -586,7 +593,7 @@ void BindDetections(py::module_& m) {
       .def("__len__", [](const PyDetections& d) { return d.set.images.size(); });
 
   m.def("detect", &Detect, "target"_a, "images"_a, py::kw_only(), "guess"_a = py::none(), "refine"_a = true,
-        "refine_checkerboards"_a = false, "rim_circles"_a = false, "threads"_a = 0, "progress"_a = py::none(),
+        "refine_checkerboards"_a = false, "checkerboard_edges"_a = false, "rim_circles"_a = false, "threads"_a = 0, "progress"_a = py::none(),
         R"(Detects the target's corners in omni images (as `omnical detect`) -> Detections.
 
 target: a Target or the path of a target spec. images: a directory or glob pattern
@@ -594,7 +601,8 @@ target: a Target or the path of a target spec. images: a directory or glob patte
 index) or a dict name -> array. guess: a Sensor or a sensor file; aprilgrid tags are
 then re-detected in virtual views and refined through it. refine: sub-pixel refinement
 of aprilgrid corners and of checkerboard corners on grid steps of 20 px and more;
-refine_checkerboards: of every checkerboard corner, small squares too. rim_circles:
+refine_checkerboards: of every checkerboard corner, small squares too. checkerboard_edges:
+with a guess, every checkerboard corner refined by its edges instead (--checkerboard-edges). rim_circles:
 also find each image's mirror rim. threads: 0 for all cores. progress(stage, done,
 total): return False to cancel. Unreadable images are skipped with a warning; raises
 InputError if none could be read.)");
@@ -677,7 +685,7 @@ are also attributes here), the warnings with their codes, the views and residual
         "detection_passes"_a = 2, "threads"_a = 0, "leave_one_out"_a = false, "tolerances"_a = py::none(),
         "distances_mm"_a = std::vector<double>(), "distances_n"_a = std::vector<double>(),
         "max_predicted_error_px"_a = 0.3, "rim_field_deg"_a = kDefaultRimFieldDeg, "holdout"_a = 0,
-        "cross_validate"_a = false, "cross_validation_distance_mm"_a = 0.0, "board_warp"_a = false,
+        "cross_validate"_a = false, "cross_validation_distance_mm"_a = 0.0, "board_warp"_a = false, "view_weights"_a = false, "checkerboard_edges"_a = false,
         "knots"_a = 0, "progress"_a = py::none(),
         R"(Calibrates the sensor (as `omnical calibrate`) -> CalibrationResult.
 
@@ -697,7 +705,10 @@ max_predicted_error_px: warn above it. holdout: K views (spread evenly) kept out
 fit and evaluated with the sensor held (result.holdout). cross_validate: each half of the
 views calibrated and compared at cross_validation_distance_mm (0: the first distance
 asked, else 2000) after the best rigid alignment (result.cross_validation). board_warp:
-also fit the board's out-of-plane warp (result.board_warp, mm). knots: the spline
+also fit the board's out-of-plane warp (result.board_warp, mm). view_weights: weight
+each view's corners by its own noise, estimated from its residuals
+(result.per_view_weight). checkerboard_edges: refine checkerboard corners through the
+first fit by their edges, every one (--checkerboard-edges). knots: the spline
 mirror's knot count (profile='spline'): 0 the guess's (6 converted), 4..16, or 'auto' to
 choose it by held-out folds (result.knot_choice).
 progress(stage, done, total): False cancels.
