@@ -122,6 +122,8 @@ std::string DetectionOptions::Check() const {
   // pass of a calibration goes through a fitted sensor that may fail validation (the
   // calibration then warns) yet still places the patches well.
   if (threads < 1) return "threads: must be >= 1 (got " + std::to_string(threads) + ")";
+  if (checkerboard_edges && !guess)
+    return "checkerboard_edges/guess: the corners are refined by their edges in patches through a sensor guess: give one";
   return "";
 }
 

@@ -43,7 +43,7 @@ Command DetectCommand() {
               if (!sensor_path->empty()) options->guess = LoadSensorYaml(*sensor_path);
               options->refine = !*no_refine;
               options->progress = TerminalProgress(context);
-              DetectedImages found = NamingFlags({{"guess", "--sensor"}, {"threads", "--threads"}}, [&] {
+              DetectedImages found = NamingFlags({{"guess", "--sensor"}, {"threads", "--threads"}, {"checkerboard_edges", "--checkerboard-edges"}}, [&] {
                 return DetectImageFiles(target, ListImages(*images), *images, *options);
               });
               found.detections.target_spec = *spec;

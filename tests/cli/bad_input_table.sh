@@ -146,6 +146,7 @@ row detect "a 64 x 2 px image" "$o.json" accepted -- detect --target "$grid" --i
 row calibrate "a 64 x 2 px image" "$o" error -- calibrate --target "$grid" --images "$f/strip" --out "$o"
 row detect "wrong target spec (type)" "$o.json" error -- detect --target "$f/target-type.yaml" --images "$rendered" --out "$o.json"
 row detect "empty image directory" "$o.json" error -- detect --target "$grid" --images "$f/no-images" --out "$o.json"
+row detect "--checkerboard-edges without --sensor" "$o.json" error -- detect --target "$grid" --images "$rendered" --checkerboard-edges --out "$o.json"
 row calibrate "one truncated image" "$o" error -- calibrate --target "$grid" --images "$f/truncated" --sensor "$guess" --out "$o"
 row calibrate "huge corner coordinate" "$o" error -- calibrate --target "$grid" --detections "$f/detections-huge.json" --sensor "$guess" --out "$o"
 row calibrate "corners found on another board" "$o" error -- calibrate --target "$grid" --detections "$f/detections-other-board.json" --sensor "$guess" --out "$o"

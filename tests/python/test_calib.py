@@ -460,6 +460,8 @@ def test_detect_cancel_and_bad_options(few):
         omnical.detect(TARGET, 42)
     with pytest.raises(omnical.InputError, match="^target: expected an omnical.Target"):
         omnical.detect(3.5, few)
+    with pytest.raises(omnical.InputError, match="^checkerboard_edges/guess: the corners are refined by their edges"):
+        omnical.detect(TARGET, few, checkerboard_edges=True)
 
 
 # --- bad input: the CLI's messages ---------------------------------------------------------
