@@ -16,6 +16,7 @@
 #include "calib/reprojection_cost.h"
 #include "calib/sensor_blocks.h"
 #include "calib/shape_smoothness.h"
+#include "calib/view_weighted_cost.h"
 #include "model/ceres_progress.h"
 #include "model/input_error.h"
 
@@ -34,30 +35,10 @@ constexpr size_t kMinViews = 3;
 // A view's corners fewer than this leave its pose (6 unknowns) barely determined.
 constexpr size_t kMinCornersPerView = 4;
 
-// A corner's cost times its view's noise weight (FitOptions::view_noise_weights), read
-// through a pointer so the weights can change between solves without rebuilding the
-// problem. Owns `cost`.
-class ViewWeightedCost : public ceres::CostFunction {
- public:
-  ViewWeightedCost(ceres::CostFunction* cost, const double* weight) : cost_(cost), weight_(weight) {
-    *mutable_parameter_block_sizes() = cost->parameter_block_sizes();
-    set_num_residuals(cost->num_residuals());
-  }
-  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
-    if (!cost_->Evaluate(parameters, residuals, jacobians)) return false;
-    const int rows = num_residuals();
-    for (int r = 0; r < rows; ++r) residuals[r] *= *weight_;
-    if (jacobians)
-      for (size_t b = 0; b < parameter_block_sizes().size(); ++b)
-        if (jacobians[b])
-          for (int k = 0; k < rows * parameter_block_sizes()[b]; ++k) jacobians[b][k] *= *weight_;
-    return true;
-  }
-
- private:
-  std::unique_ptr<ceres::CostFunction> cost_;
-  const double* weight_;
-};
+// FitOptions::view_noise_weights: a view whose residuals leave fewer degrees of freedom
+// keeps the pooled noise (weight 1). From 2 of them (4 corners) 1 / sigma^2 has no finite
+// mean: the clamp alone would decide its weight.
+constexpr int kMinViewFreedom = 20;
 
 // A design tolerance as a residual: noise_px x (x - design) / tolerance. Scaled by the
 // corner noise so that, next to residuals in px, it weighs as a Gaussian prior of that
@@ -502,29 +483,33 @@ class FitRun {
   void WeighViewsByNoise() {
     if (!options_.view_noise_weights || !options_.refine.RefinesSensor()) return;
     for (int round = 0; round < 2; ++round) {
-      std::vector<double> square(views_, 0.0);
+      std::vector<double> square_px2(views_, 0.0);
       std::vector<int> count(views_, 0);
       for (const Residual& r : residuals_) {
         double value[2];
         if (r.outlier || !result_.view_left_out[r.view].empty() || !(*r.functor)(r.blocks.data(), value)) continue;
-        square[r.view] += value[0] * value[0] + value[1] * value[1];
+        square_px2[r.view] += value[0] * value[0] + value[1] * value[1];
         ++count[r.view];
       }
-      double pooled_square = 0.0;
+      double pooled_square_px2 = 0.0;
       int pooled_freedom = 0;
       for (size_t v = 0; v < views_; ++v)
-        if (2 * count[v] > 6) pooled_square += square[v], pooled_freedom += 2 * count[v] - 6;
-      if (pooled_freedom == 0 || !(pooled_square > 0.0)) return;
-      const double pooled = std::sqrt(pooled_square / pooled_freedom);
+        if (2 * count[v] > 6) pooled_square_px2 += square_px2[v], pooled_freedom += 2 * count[v] - 6;
+      if (pooled_freedom == 0 || !(pooled_square_px2 > 0.0)) break;
+      const double pooled_px = std::sqrt(pooled_square_px2 / pooled_freedom);
       for (size_t v = 0; v < views_; ++v) {
         const int freedom = 2 * count[v] - 6;
-        const double sigma = freedom > 0 ? std::sqrt(square[v] / freedom) : pooled;
-        view_weight_[v] = sigma > 0.0 ? std::clamp(pooled / sigma, kMinViewWeight, kMaxViewWeight) : kMaxViewWeight;
+        const double sigma_px = freedom >= kMinViewFreedom ? std::sqrt(square_px2[v] / freedom) : pooled_px;
+        view_weight_[v] =
+            sigma_px > 0.0 ? std::clamp(pooled_px / sigma_px, kMinViewWeight, kMaxViewWeight) : kMaxViewWeight;
       }
-      prior_noise_px_ = std::max(1e-3, pooled);
+      prior_noise_px_ = std::max(1e-3, pooled_px);
       Solve(Precision::kStart);
     }
+    // Reported as applied (whatever round stopped); a left-out view had none.
     result_.per_view_weight = view_weight_;
+    for (size_t v = 0; v < views_; ++v)
+      if (!result_.view_left_out[v].empty()) result_.per_view_weight[v] = NAN;
   }
 
   // The last stage, to the fit's own tolerances.

@@ -67,7 +67,8 @@ struct FitResult {
   double rms_px = 0.0;  // per corner, over the inliers
   std::vector<double> per_view_rms_px;
   // Per view: the weight its corners' residuals were multiplied by (FitOptions::
-  // view_noise_weights: pooled sigma / the view's sigma); empty when not weighted.
+  // view_noise_weights: pooled sigma / the view's sigma); NaN for a view left out; empty
+  // when not weighted.
   std::vector<double> per_view_weight;
   // Residual (observed - predicted... as fitted: predicted - observed) per view, per corner
   // in the order of the detections; NaN where the corner was dropped.

@@ -147,7 +147,7 @@ json ToJson(const CalibrationRecord& r) {
   if (r.covariance_ok) j["predicted_error_definition"] = kPredictedErrorDefinition;
   j["warnings"] = r.warnings;
   for (const auto& [image, rms] : r.per_view_rms_px) j["per_view_rms_px"][image] = rms;
-  for (const auto& [image, weight] : r.per_view_weight) j["per_view_weight"][image] = weight;
+  for (const auto& [image, weight] : r.per_view_weight) j["per_view_weight"][image] = NumberOrNull(weight);
   for (const ParameterEstimate& p : r.parameters)
     j["parameters"][p.name] = {{"value", p.value}, {"std", NumberOrNull(p.std)}, {"fixed", p.fixed}};
   for (const auto& [image, pose] : r.poses) {
@@ -267,7 +267,7 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
     if (j.contains("per_view_rms_px"))  // a view left out has no RMS: null
       for (const auto& [image, rms] : at("per_view_rms_px").items()) r.per_view_rms_px[image] = NumberOrNan(rms);
     if (j.contains("per_view_weight"))
-      for (const auto& [image, weight] : at("per_view_weight").items()) r.per_view_weight[image] = weight.get<double>();
+      for (const auto& [image, weight] : at("per_view_weight").items()) r.per_view_weight[image] = NumberOrNan(weight);
     for (const auto& [parameter, p] : at("parameters").items())
       r.parameters.push_back({parameter, p.at("value").get<double>(), NumberOrNan(p.at("std")), p.at("fixed").get<bool>()});
     if (j.contains("poses"))

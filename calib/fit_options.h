@@ -88,9 +88,11 @@ struct FitOptions {
   // noise sigma_v is estimated from its own residuals (its pose's 6 degrees of freedom
   // taken off), its corners weighted by sigma / sigma_v (sigma pooled over all views), and
   // the fit repeated, twice. Views differ several-fold in corner noise (rendered rim views
-  // ~5x the inner ones; the real dev set's 0.18-0.50 px RMS): unweighted, the noisy ones
+  // ~5x the inner ones; the real dev set's 0.18-0.46 px RMS): unweighted, the noisy ones
   // pull the sensor as hard as sharp ones and the covariance, scaled by one pooled sigma,
-  // misstates both. The weights are clamped to [kMinViewWeight, kMaxViewWeight].
+  // misstates both. The weights are clamped to [kMinViewWeight, kMaxViewWeight]; a view
+  // with under 20 degrees of freedom (13 corners) keeps weight 1. The robust loss then
+  // acts on the weighted residuals: its scale is in px of a unit-weight corner.
   bool view_noise_weights = false;
   // Design tolerances: one standard deviation of a Gaussian prior around the guess's value,
   // per parameter name as FitResult names them (fx_px, cx_px, k1, m_mm, decenter_x_mm,

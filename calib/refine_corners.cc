@@ -87,16 +87,16 @@ bool SampleProfile(const cv::Mat& image, const Eigen::Vector2d& base, const Eige
 
 // Crossings (t along an edge, s across it) fitted by the line s = a + b t (least squares);
 // scatter: their RMS about it.
-struct EdgeLineFit {
+struct EdgeFit {
   double a = 0.0, b = 0.0, scatter = 0.0;
 };
-EdgeLineFit FitEdgeLine(const std::vector<double>& ts, const std::vector<double>& ss) {
+EdgeFit FitEdgeLine(const std::vector<double>& ts, const std::vector<double>& ss) {
   double mt = 0, ms = 0, stt = 0, sts = 0;
   for (size_t i = 0; i < ts.size(); ++i) mt += ts[i], ms += ss[i];
   mt /= ts.size();
   ms /= ts.size();
   for (size_t i = 0; i < ts.size(); ++i) stt += (ts[i] - mt) * (ts[i] - mt), sts += (ts[i] - mt) * (ss[i] - ms);
-  EdgeLineFit fit;
+  EdgeFit fit;
   fit.b = sts / stt;
   fit.a = ms - fit.b * mt;
   for (size_t i = 0; i < ts.size(); ++i) fit.scatter += std::pow(ss[i] - fit.a - fit.b * ts[i], 2);
@@ -105,20 +105,28 @@ EdgeLineFit FitEdgeLine(const std::vector<double>& ts, const std::vector<double>
 }
 
 // Crossings fitted by the parabola s = a + b t + c t^2 (least squares): a and b the curve's
-// offset and slope at t = 0; scatter: their RMS about it.
-EdgeLineFit FitEdgeCurve(const std::vector<double>& ts, const std::vector<double>& ss) {
+// offset and slope at t = 0; scatter: their RMS about it. t is scaled by its largest value
+// for the solve (a patch's t reach hundreds of px: the normal equations' condition grows
+// as t^4).
+EdgeFit FitEdgeCurve(const std::vector<double>& ts, const std::vector<double>& ss) {
+  double scale = 0.0;
+  for (double t : ts) scale = std::max(scale, std::abs(t));
   Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
   Eigen::Vector3d right = Eigen::Vector3d::Zero();
   for (size_t i = 0; i < ts.size(); ++i) {
-    const Eigen::Vector3d row(1.0, ts[i], ts[i] * ts[i]);
+    const double u = ts[i] / scale;
+    const Eigen::Vector3d row(1.0, u, u * u);
     normal += row * row.transpose();
     right += row * ss[i];
   }
   const Eigen::Vector3d abc = normal.ldlt().solve(right);
-  EdgeLineFit fit;
+  EdgeFit fit;
   fit.a = abc[0];
-  fit.b = abc[1];
-  for (size_t i = 0; i < ts.size(); ++i) fit.scatter += std::pow(ss[i] - abc[0] - abc[1] * ts[i] - abc[2] * ts[i] * ts[i], 2);
+  fit.b = abc[1] / scale;
+  for (size_t i = 0; i < ts.size(); ++i) {
+    const double u = ts[i] / scale;
+    fit.scatter += std::pow(ss[i] - abc[0] - abc[1] * u - abc[2] * u * u, 2);
+  }
   fit.scatter = std::sqrt(fit.scatter / ts.size());
   return fit;
 }
@@ -184,7 +192,7 @@ bool RefineSquareCorner(const cv::Mat& image, const Eigen::Vector2d& start, cons
         if (double s; EdgeCrossing(image, corner + t * edge[e], normal, 0.8 * cell_px, 1.6 * cell_px, ink, &s))
           ts.push_back(t), ss.push_back(s);
       if (ts.size() < 4) return false;
-      const EdgeLineFit line = FitEdgeLine(ts, ss);
+      const EdgeFit line = FitEdgeLine(ts, ss);
       // A straight edge fits its crossings to a small fraction of a cell; crossings
       // scattered over the profile mean the start was off the corner (another edge, the
       // data bits): keep the detector's point.
@@ -230,23 +238,29 @@ bool RefineCheckerJunction(const cv::Mat& image, const Eigen::Vector2d& start, c
     const double sine = std::abs(line[0].x() * d.y() - line[0].y() * d.x());
     if (sine > across) across = sine, line[1] = d;
   }
-  if (across < 0.5) return false;  // squares sheared beyond 30 deg: not a junction we can read
+  if (across < 0.5) return false;  // grid lines within 30 deg of each other: not a junction we can read
   Eigen::Vector2d corner = start;
   for (int pass = 0; pass < 2; ++pass) {
     Eigen::Vector2d point[2], direction[2];
     for (int e = 0; e < 2; ++e) {
       const Eigen::Vector2d normal(-line[e].y(), line[e].x());
       std::vector<double> ts, ss;
+      int per_side[2] = {0, 0};
       for (double t = 0.25 * square_px; t <= 0.85 * square_px; t += 0.5)
-        for (double sign : {-1.0, 1.0}) {
-          // Profiles stay between the other grid line and the next edge parallel to this one.
+        for (int side = 0; side < 2; ++side) {
+          const double signed_t = side == 0 ? -t : t;
+          // Profiles reach across this edge only as far as the other grid line allows.
           const double half_px = std::min(0.45 * square_px, 0.7 * t * across);
-          if (double s; JunctionEdgeCrossing(image, corner + sign * t * line[e], normal, half_px, &s))
-            ts.push_back(sign * t), ss.push_back(s);
+          if (double s; JunctionEdgeCrossing(image, corner + signed_t * line[e], normal, half_px, &s))
+            ts.push_back(signed_t), ss.push_back(s), ++per_side[side];
         }
-      const double profiles = 2.0 * (0.85 - 0.25) * square_px / 0.5;
-      if (ts.size() < 0.6 * profiles) return false;
-      const EdgeLineFit fit = FitEdgeCurve(ts, ss);
+      // Both sides: the junction's blur is odd about the corner and cancels in the offset
+      // only when both are there (one side lost to the rim or an occluder: keep the point).
+      const double profiles_per_side = (0.85 - 0.25) * square_px / 0.5;
+      if (per_side[0] < 0.4 * profiles_per_side || per_side[1] < 0.4 * profiles_per_side ||
+          ts.size() < 1.2 * profiles_per_side)
+        return false;
+      const EdgeFit fit = FitEdgeCurve(ts, ss);
       // Crossings scattered over the profile: the start was off the junction, or the edge
       // is not there (the rim, an occluder): keep the detector's point.
       if (fit.scatter > 0.05 * square_px) return false;
@@ -257,7 +271,7 @@ bool RefineCheckerJunction(const cv::Mat& image, const Eigen::Vector2d& start, c
     line[0] = direction[0];
     line[1] = direction[1];
   }
-  if ((corner - start).norm() > 0.25 * square_px) return false;
+  if (!((corner - start).norm() <= 0.25 * square_px)) return false;  // NaN too
   *refined = corner;
   return true;
 }

@@ -54,7 +54,7 @@ constexpr double kMinRefinedCheckerStepPx = 20.0;
 // curve: a line would cut its chord, off the corner), the tangents at the corner
 // intersected. cornerSubPix's gradient window is biased where the blur varies across it:
 // in a patch resampled from near the rim the omni image's blur is stretched more on the
-// outer side, and OpenCV's own corners (kept on small squares) sat 0.02-0.09 px inwards
+// outer side, and OpenCV's own corners (kept on small squares) sat 0.02-0.11 px inwards
 // per view on the realistic checkerboard renders, enough to put fx 11 std off on a
 // re-rendered set (docs/calibrate.md, "Checkerboard corners by their edges").
 enum class CheckerRefinement { kSubPixel, kEdges };

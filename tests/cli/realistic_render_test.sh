@@ -18,8 +18,8 @@
 # 97 % (554: 97.2 %; 3 cut). Short of the 99 % wanted. Found corners within 0.3 px RMS of
 # the truth.
 # checkerboard-edges: the checkerboard set with --checkerboard-edges (every corner refined by
-# its edges through the first fit, calib/refine_corners.h): measured within 1.9 std (k1;
-# fx 1.5), 556 used, refined corners 0.068 px RMS from the truth (0.116 without): bounded at
+# its edges through the first fit, calib/refine_corners.h): measured within 2.2 std (k1;
+# fx 0.8), 556 used, refined corners 0.065 px RMS from the truth (0.116 without): bounded at
 # 0.1 px.
 # Usage: realistic_render_test.sh OMNICAL_BINARY SOURCE_DIR [aprilgrid|checkerboard|checkerboard-edges]
 set -u
