@@ -117,7 +117,7 @@ class FitRun {
     result_.guess_rim_radius_mm = guess.rim_radius_mm;
     rotations_.resize(views_);
     translations_.resize(views_);
-    view_weight_.assign(views_ + 1, 1.0);  // never resized after: the costs point into it
+    view_weight_.assign(views_, 1.0);  // never resized after: the costs point into it
     for (size_t v = 0; v < views_; ++v) {
       const Eigen::Quaterniond& q = initial_poses[v].camera_from_target_rotation;
       rotations_[v] = {q.x(), q.y(), q.z(), q.w()};
@@ -149,7 +149,6 @@ class FitRun {
  private:
   struct Residual {
     size_t view, index;
-    size_t noise_group;  // index into view_weight_: the view, or views_ for an unrefined corner
     std::unique_ptr<Cost> functor;  // a copy kept to evaluate plain residuals afterwards
     std::vector<double*> blocks;
     ceres::ResidualBlockId id;
@@ -201,10 +200,9 @@ class FitRun {
         }
         ceres::CostFunction* cost = Cost::Create(guess_, point->second, image.corners[i].pixel, basis);
         if (options_.threads > 1) cost = evaluation_.Wrap(cost, blocks);
-        const size_t noise_group = image.corners[i].unrefined ? views_ : v;
-        if (options_.view_noise_weights) cost = new ViewWeightedCost(cost, &view_weight_[noise_group]);
+        if (options_.view_noise_weights) cost = new ViewWeightedCost(cost, &view_weight_[v]);
         const ceres::ResidualBlockId id = problem_.AddResidualBlock(cost, loss_.get(), blocks);
-        residuals_.push_back({v, i, noise_group, std::move(functor), blocks, id});
+        residuals_.push_back({v, i, std::move(functor), blocks, id});
         ++view_residuals_[v];
       }
     }
@@ -465,7 +463,7 @@ class FitRun {
       if (r.outlier || !(*r.functor)(r.blocks.data(), value)) continue;
       const double square = value[0] * value[0] + value[1] * value[1];
       sum_square_ += square;
-      weighted_square += square * view_weight_[r.noise_group] * view_weight_[r.noise_group];
+      weighted_square += square * view_weight_[r.view] * view_weight_[r.view];
       ++inliers_;
     }
     std::vector<double*> all;
@@ -481,46 +479,37 @@ class FitRun {
   // FitOptions::view_noise_weights: each view's noise from its own inlier residuals (its
   // 2 n - 6 degrees of freedom), weights sigma_pooled / sigma_v, the fit repeated; twice,
   // since each refit moves the residuals the weights came from (a third changed the
-  // realistic sets' weights by under 1 %). Unrefined corners are one more group, over all
-  // views: their poses are the refined corners' (2 n degrees of freedom), and too few of
-  // them to tell their noise sit at the lowest weight (they are ~5x noisier as a rule).
+  // realistic sets' weights by under 1 %).
   void WeighViewsByNoise() {
     if (!options_.view_noise_weights || !options_.refine.RefinesSensor()) return;
-    const size_t groups = views_ + 1;
     for (int round = 0; round < 2; ++round) {
-      std::vector<double> square_px2(groups, 0.0);
-      std::vector<int> count(groups, 0);
+      std::vector<double> square_px2(views_, 0.0);
+      std::vector<int> count(views_, 0);
       for (const Residual& r : residuals_) {
         double value[2];
         if (r.outlier || !result_.view_left_out[r.view].empty() || !(*r.functor)(r.blocks.data(), value)) continue;
-        square_px2[r.noise_group] += value[0] * value[0] + value[1] * value[1];
-        ++count[r.noise_group];
+        square_px2[r.view] += value[0] * value[0] + value[1] * value[1];
+        ++count[r.view];
       }
-      std::vector<int> freedom(groups);
-      for (size_t g = 0; g < groups; ++g) freedom[g] = 2 * count[g] - (g < views_ ? 6 : 0);
       double pooled_square_px2 = 0.0;
       int pooled_freedom = 0;
       for (size_t v = 0; v < views_; ++v)
-        if (freedom[v] > 0) pooled_square_px2 += square_px2[v], pooled_freedom += freedom[v];
+        if (2 * count[v] > 6) pooled_square_px2 += square_px2[v], pooled_freedom += 2 * count[v] - 6;
       if (pooled_freedom == 0 || !(pooled_square_px2 > 0.0)) break;
       const double pooled_px = std::sqrt(pooled_square_px2 / pooled_freedom);
-      for (size_t g = 0; g < groups; ++g) {
-        const bool told = freedom[g] >= kMinViewFreedom;
-        const double sigma_px = told ? std::sqrt(square_px2[g] / freedom[g]) : pooled_px;
-        view_weight_[g] = g == views_ && !told ? kMinViewWeight
-                          : sigma_px > 0.0     ? std::clamp(pooled_px / sigma_px, kMinViewWeight, kMaxViewWeight)
-                                               : kMaxViewWeight;
+      for (size_t v = 0; v < views_; ++v) {
+        const int freedom = 2 * count[v] - 6;
+        const double sigma_px = freedom >= kMinViewFreedom ? std::sqrt(square_px2[v] / freedom) : pooled_px;
+        view_weight_[v] =
+            sigma_px > 0.0 ? std::clamp(pooled_px / sigma_px, kMinViewWeight, kMaxViewWeight) : kMaxViewWeight;
       }
       prior_noise_px_ = std::max(1e-3, pooled_px);
       Solve(Precision::kStart);
     }
     // Reported as applied (whatever round stopped); a left-out view had none.
-    result_.per_view_weight.assign(view_weight_.begin(), view_weight_.begin() + views_);
+    result_.per_view_weight = view_weight_;
     for (size_t v = 0; v < views_; ++v)
       if (!result_.view_left_out[v].empty()) result_.per_view_weight[v] = NAN;
-    const bool any_unrefined =
-        std::any_of(residuals_.begin(), residuals_.end(), [&](const Residual& r) { return r.noise_group == views_; });
-    result_.unrefined_weight = any_unrefined ? view_weight_[views_] : NAN;
   }
 
   // The last stage, to the fit's own tolerances.
@@ -709,7 +698,7 @@ class FitRun {
   ceres::Problem problem_;
   std::vector<Residual> residuals_;
   std::vector<size_t> view_residuals_;
-  std::vector<double> view_weight_;  // per noise group (each view, then unrefined corners); 1 unless weighted
+  std::vector<double> view_weight_;  // FitOptions::view_noise_weights; 1 otherwise
   std::vector<Prior> priors_;
   ceres::ResidualBlockId smoothness_ = nullptr;  // a free-form profile's (calib/shape_smoothness.h)
   double prior_noise_px_ = 1.0;  // the corner noise the priors are scaled by; updated between solves

@@ -27,7 +27,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <cmath>
 #include <map>
 #include <optional>
 #include <set>
@@ -71,9 +70,6 @@ struct FitResult {
   // view_noise_weights: pooled sigma / the view's sigma); NaN for a view left out; empty
   // when not weighted.
   std::vector<double> per_view_weight;
-  // The weight of the corners marked unrefined (CornerObservation::unrefined), one noise
-  // group over all views when weighted; NaN when there were none or nothing was weighted.
-  double unrefined_weight = NAN;
   // Residual (observed - predicted... as fitted: predicted - observed) per view, per corner
   // in the order of the detections; NaN where the corner was dropped.
   std::vector<std::vector<Eigen::Vector2d>> residuals_px;

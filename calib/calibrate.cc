@@ -29,12 +29,11 @@ constexpr double kOneDistanceRatio = 1.5;
 // Where the two halves are compared when the user names no distance: a room's far wall.
 constexpr double kDefaultCrossValidationDistanceMm = 2000.0;
 
-// The detections without corners the target does not have and, unless `keep_unrefined`,
-// without corners marked unrefined (the detector's own position, ~5x worse than refined
-// ones: unweighted among them they biased the mirror's size on renders; with per-view
-// weights they are fitted as a noise group of their own); *unrefined counts the corners
-// marked unrefined. Throws if no corner id matches.
-DetectionSet FittableCorners(const CalibrationInput& input, DetectionSet detections, bool keep_unrefined, int* unrefined) {
+// The detections without corners the target does not have and without corners marked
+// unrefined (the detector's own position, ~5x worse than refined ones: unweighted among
+// them they biased the mirror's size on renders); *unrefined counts the latter. Throws if
+// no corner id matches.
+DetectionSet FittableCorners(const CalibrationInput& input, DetectionSet detections, int* unrefined) {
   std::set<int> ids;
   for (const TargetCorner& c : input.target.corners()) ids.insert(c.id);
   int matched = 0;
@@ -45,7 +44,7 @@ DetectionSet FittableCorners(const CalibrationInput& input, DetectionSet detecti
                                          if (!ids.count(c.id)) return true;
                                          ++matched;
                                          *unrefined += c.unrefined;
-                                         return c.unrefined && !keep_unrefined;
+                                         return c.unrefined;
                                        }),
                         image.corners.end());
   }
@@ -373,7 +372,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   FitOptions fit_options = FitOptionsFor(input, options, guess, &warnings);
 
   int unrefined = 0;
-  UsableViews views = ViewsForFit(guess, input, FittableCorners(input, detections, options.view_weights, &unrefined), &warnings);
+  UsableViews views = ViewsForFit(guess, input, FittableCorners(input, detections, &unrefined), &warnings);
   const std::set<std::string> holdout_names = HoldoutNames(input, views, options.holdout_views);
   UsableViews held = SplitOff(&views, holdout_names);
   // Too few views to halve: said before the fit, not after it (the halves are of the views
@@ -465,7 +464,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
                                   [](const CalibrationWarning& w) { return w.code == WarningCode::kViewSkipped; }),
                    warnings.end());
     // Boards refused so far stay out (their corners stay in `detections`: every corner found).
-    views = ViewsForFit(*refit_start, input, FittableCorners(input, WithoutImages(detections, refused_images), options.view_weights, &unrefined),
+    views = ViewsForFit(*refit_start, input, FittableCorners(input, WithoutImages(detections, refused_images), &unrefined),
                         &warnings);
     held = SplitOff(&views, holdout_names);
     fit = FitSensor(*refit_start, input.target, views.detections, views.poses, fit_options);
@@ -553,8 +552,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   record.converged = fit.converged;
   record.outliers = fit.outliers;
   record.dropped = fit.dropped;
-  (options.view_weights ? record.unrefined_corners_fitted : record.unrefined_corners_left_out) = unrefined;
-  record.unrefined_corner_weight = fit.unrefined_weight;
+  record.unrefined_corners_left_out = unrefined;
   record.observations = fit.observations;
   record.solver_report = fit.solver_report;
   record.fixed_blocks = fit_options.refine.HeldNames();

@@ -64,10 +64,6 @@ json ToJson(const CalibrationRecord& r) {
   j["outliers"] = r.outliers;
   j["dropped"] = r.dropped;
   j["unrefined_corners_left_out"] = r.unrefined_corners_left_out;
-  if (r.unrefined_corners_fitted > 0) {
-    j["unrefined_corners_fitted"] = r.unrefined_corners_fitted;
-    j["unrefined_corner_weight"] = NumberOrNull(r.unrefined_corner_weight);
-  }
   j["observations"] = r.observations;
   j["solver_report"] = r.solver_report;
   j["fixed_blocks"] = r.fixed_blocks;
@@ -178,10 +174,6 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
     r.outliers = at("outliers").get<int>();
     r.dropped = at("dropped").get<int>();
     r.unrefined_corners_left_out = at("unrefined_corners_left_out").get<int>();
-    if (j.contains("unrefined_corners_fitted")) {
-      r.unrefined_corners_fitted = at("unrefined_corners_fitted").get<int>();
-      r.unrefined_corner_weight = NumberOrNan(at("unrefined_corner_weight"));
-    }
     r.observations = at("observations").get<int>();
     r.solver_report = at("solver_report").get<std::string>();
     r.fixed_blocks = at("fixed_blocks").get<std::set<std::string>>();

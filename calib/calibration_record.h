@@ -25,10 +25,6 @@ struct CalibrationRecord {
   double rms_all_px = NAN;  // the same over every fitted corner, outliers included
   bool converged = false;
   int outliers = 0, dropped = 0, unrefined_corners_left_out = 0, observations = 0;
-  // Corners marked unrefined fitted as their own noise group (CalibrationOptions::
-  // view_weights) and the weight they got (NaN: none fitted).
-  int unrefined_corners_fitted = 0;
-  double unrefined_corner_weight = NAN;
   std::string solver_report;
   std::set<std::string> fixed_blocks;
   double robust_loss_px = 0.0;

@@ -323,59 +323,6 @@ TEST(BundleFit, ViewNoiseWeightsFollowEachViewsNoise) {
   }
 }
 
-// Corners marked unrefined (a failed sub-pixel refinement: the detector's own position)
-// are one noise group over all views: every fourth corner given 6x the others' noise
-// (0.3 against 0.05 px per coordinate) gets the weight 0.05 / 0.3 = 0.167 within 15 %
-// (two weighting rounds from a fit that counted them alike; the estimate's own spread over
-// ~280 corners is ~4 %), the views theirs ~1 (their own corners share one noise), and the
-// fit holds every parameter within 3 std.
-TEST(BundleFit, UnrefinedCornersFormANoiseGroupOfTheirOwn) {
-  const Truth truth = MixedDistanceObservations(
-      LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-sph-misaligned.yaml"));
-  const std::vector<ParameterEstimate> expected = SensorParameters(truth.sensor);
-  Sensor guess = Perturbed(truth.sensor);
-  {  // as in ViewNoiseWeightsFollowEachViewsNoise: the designed m, the true tilt (the gauge)
-    SensorModel m = guess.model();
-    auto& sphere = std::get<Catadioptric<double, SphereProfile, PinholeLens>>(m);
-    const auto& true_sphere = std::get<Catadioptric<double, SphereProfile, PinholeLens>>(truth.sensor.model());
-    sphere.pose.m_mm = true_sphere.pose.m_mm;
-    sphere.pose.tilt_x_rad = true_sphere.pose.tilt_x_rad;
-    guess = Sensor(m);
-  }
-  DetectionSet noisy = truth.detections;
-  std::mt19937 rng(7);
-  std::normal_distribution<double> sharp(0.0, 0.05), coarse(0.0, 0.3);
-  int unrefined = 0;
-  for (ImageDetections& image : noisy.images)
-    for (size_t i = 0; i < image.corners.size(); ++i) {
-      CornerObservation& c = image.corners[i];
-      c.unrefined = i % 4 == 3;
-      unrefined += c.unrefined;
-      auto& noise = c.unrefined ? coarse : sharp;
-      c.pixel += Eigen::Vector2d(noise(rng), noise(rng));
-    }
-  ASSERT_GT(unrefined, 100);
-  std::vector<TargetPose> poses(noisy.images.size());
-  for (size_t v = 0; v < poses.size(); ++v) ASSERT_TRUE(InitialTargetPose(guess, truth.target, noisy.images[v], &poses[v]));
-  FitOptions options = FitOptions::DefaultsFor(guess);
-  options.refine.m = false;  // the dolly-zoom valley, as in NoisyFitHolds
-  options.robust_loss_px = 0.0;
-  const FitResult plain = FitSensor(guess, truth.target, noisy, poses, options);
-  EXPECT_TRUE(std::isnan(plain.unrefined_weight));
-  options.view_noise_weights = true;
-  const FitResult weighted = FitSensor(guess, truth.target, noisy, poses, options);
-  ASSERT_TRUE(weighted.covariance_ok);
-  EXPECT_NEAR(weighted.unrefined_weight, 0.05 / 0.3, 0.15 * 0.05 / 0.3);
-  for (size_t v = 0; v < noisy.images.size(); ++v)
-    EXPECT_NEAR(weighted.per_view_weight[v], 1.0, 0.15) << "view " << v;
-  for (size_t k = 0; k < expected.size(); ++k) {
-    if (weighted.parameters[k].fixed) continue;
-    const ParameterEstimate& p = weighted.parameters[k];
-    EXPECT_LT(std::abs(p.value - expected[k].value), 3.0 * p.std)
-        << p.name << " = " << p.value << " +- " << p.std << ", truth " << expected[k].value;
-  }
-}
-
 std::vector<TargetPose> StartingPoses(const Sensor& guess, const Truth& truth) {
   std::vector<TargetPose> poses(truth.detections.images.size());
   for (size_t v = 0; v < poses.size(); ++v)

@@ -129,9 +129,7 @@ Command CalibrateCommand() {
                          "sides of each junction), every corner, instead of cornerSubPix on squares of 20 px and more");
             sub.add_flag("--view-weights", library.view_weights,
                          "Weight each view's corners by its own noise, estimated from its residuals (views as sharp "
-                         "as they are noisy: blur and JPEG near the rim), and fit the corners whose refinement failed as a noise "
-                         "group of their own instead of leaving them out; calibration.json per_view_weight, "
-                         "unrefined_corner_weight");
+                         "as they are noisy: blur and JPEG near the rim); calibration.json per_view_weight");
             sub.add_option("--knots", options->knots,
                            "With --profile spline: the mirror's knot count (4..16), or auto: chosen by held-out "
                            "folds of the views (calibration.json knot_choice)");

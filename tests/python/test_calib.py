@@ -356,47 +356,11 @@ def test_view_weights_equal_cli(runs, tmp_path):
     assert_json_equal(json.loads(result.to_json()), cli)
     weights = result.per_view_weight
     assert set(weights) == set(cli["per_view_weight"]) == set(result.per_view_rms_px) and len(weights) >= 3
-    # Over each view's refined corners: the unrefined ones (a few here) are a group of their own.
-    unrefined = {view.image: set(view.ids[view.unrefined].tolist()) for view in omnical.Detections.load(detections).images}
-    scaled = []
-    for v in weights:
-        ids, px = result.residuals[v]
-        refined = np.array([i not in unrefined[v] for i in ids.tolist()]) & np.isfinite(px).all(axis=1)
-        n = int(refined.sum())
-        scaled.append(weights[v] * (np.sum(px[refined] ** 2) / n) ** 0.5 * (2 * n / (2 * n - 6)) ** 0.5)
+    counts = {view.image: len(view) for view in omnical.Detections.load(detections).images}
+    scaled = [weights[v] * result.per_view_rms_px[v] * (2 * counts[v] / (2 * counts[v] - 6)) ** 0.5 for v in weights]
     assert max(scaled) < 1.15 * min(scaled), scaled
     assert not omnical.calibrate(TARGET, detections=detections, guess=GUESS).per_view_weight
     assert "per_view_weight" not in json.loads((runs.out / "cli" / "calibration.json").read_text())
-
-
-def test_view_weights_fit_unrefined_corners_equal_cli(runs, tmp_path):
-    """With view_weights, corners marked unrefined are fitted as one noise group (not left
-    out): both front ends count them and give them the same weight; without, they are left
-    out. Every fifth corner of the bundled detections marked besides those the detection left
-    unrefined, so the group is large enough to tell its own noise (the weight then is not the
-    floor, 0.1, nor 1 exactly)."""
-    marked = json.loads((runs.out / "cli" / "detections.json").read_text())
-    count = 0  # with the few the detection left unrefined
-    for image in marked["images"]:
-        for k, corner in enumerate(image["corners"]):
-            if k % 5 == 4:
-                corner["refined"] = False
-            count += corner.get("refined", True) is False
-    detections = tmp_path / "marked.json"
-    detections.write_text(json.dumps(marked))
-    result, done = beside_cli(
-        ["-q", "calibrate", "--target", TARGET, "--detections", detections, "--sensor", GUESS, "--view-weights",
-         "--out", tmp_path / "cli"],
-        lambda: omnical.calibrate(TARGET, detections=detections, guess=GUESS, view_weights=True))
-    assert done.returncode == 0, done.stderr
-    cli = json.loads((tmp_path / "cli" / "calibration.json").read_text())
-    assert_json_equal(json.loads(result.to_json()), cli)
-    assert count >= 20 and result.unrefined_corners_fitted == cli["unrefined_corners_fitted"] == count
-    assert result.unrefined_corners_left_out == 0
-    assert 0.1 < result.unrefined_corner_weight == cli["unrefined_corner_weight"] and result.unrefined_corner_weight != 1.0
-    plain = omnical.calibrate(TARGET, detections=detections, guess=GUESS)
-    assert plain.unrefined_corners_left_out == count and plain.unrefined_corners_fitted == 0
-    assert math.isnan(plain.unrefined_corner_weight)
 
 
 # --- detect ------------------------------------------------------------------------------

@@ -180,11 +180,7 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
   field("outliers", &CalibrationRecord::outliers, "Corners removed as gross outliers.");
   field("dropped", &CalibrationRecord::dropped, "Corners not projectable at the start.");
   field("unrefined_corners_left_out", &CalibrationRecord::unrefined_corners_left_out,
-        "Corners whose sub-pixel refinement failed, left out of the fit (without view_weights).");
-  field("unrefined_corners_fitted", &CalibrationRecord::unrefined_corners_fitted,
-        "Corners whose sub-pixel refinement failed, fitted as a noise group of their own (view_weights=True).");
-  field("unrefined_corner_weight", &CalibrationRecord::unrefined_corner_weight,
-        "The weight those corners had in the fit (pooled noise / theirs; NaN: none fitted).");
+        "Corners whose sub-pixel refinement failed, left out of the fit.");
   field("solver_report", &CalibrationRecord::solver_report, "Ceres' one-line report.");
   field("fixed_blocks", &CalibrationRecord::fixed_blocks, "The parameter blocks held constant (set of str).");
   field("robust_loss_px", &CalibrationRecord::robust_loss_px, "The robust loss scale used (px; 0: least squares).");
@@ -711,8 +707,7 @@ views calibrated and compared at cross_validation_distance_mm (0: the first dist
 asked, else 2000) after the best rigid alignment (result.cross_validation). board_warp:
 also fit the board's out-of-plane warp (result.board_warp, mm). view_weights: weight
 each view's corners by its own noise, estimated from its residuals
-(result.per_view_weight), and fit the corners whose refinement failed as a noise group of
-their own (result.unrefined_corner_weight) instead of leaving them out. checkerboard_edges: refine checkerboard corners through the
+(result.per_view_weight). checkerboard_edges: refine checkerboard corners through the
 first fit by their edges, every one (--checkerboard-edges). knots: the spline
 mirror's knot count (profile='spline'): 0 the guess's (6 converted), 4..16, or 'auto' to
 choose it by held-out folds (result.knot_choice).
