@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "calib/board_size_screen.h"
+#include "calib/checkerboard_completion.h"
 #include "calib/cross_validation.h"
 #include "calib/fit_covariance.h"
 #include "calib/image_file.h"
@@ -312,6 +313,14 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   const int sources = !input.image_paths.empty() + !input.images.empty() + input.detections.has_value();
   if (sources != 1) throw InputError("images: give either images (detected here) or detections");
   const bool from_images = !input.detections;
+  // Said, not ignored: edge refinement and the predicted corners are steps of the second
+  // detection pass over a checkerboard's images.
+  if (options.checkerboard_edges && !from_images)
+    throw InputError("checkerboard_edges: refines the corners found in images, not corners given as detections "
+                     "(detect --sensor ... --checkerboard-edges refines them there)");
+  if (options.checkerboard_edges && input.target.type() != CalibrationTarget::Type::kCheckerboard)
+    throw InputError("checkerboard_edges: the target is not a checkerboard (an aprilgrid's corners are refined by "
+                     "their edges always)");
   std::vector<CalibrationWarning> warnings;
   CalibrationRecord record;
   std::vector<PredictedError> predicted;
@@ -457,8 +466,16 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     if (checkerboard && !FindMissedCheckerboards(input, options, *fit.sensor, &found) && pass > 2) break;
     refit_start = *fit.sensor;
     passes_run = pass;
-    detections = checkerboard ? CheckerboardsRefinedThrough(input, options, *refit_start, found)
-                              : FindCorners(input, options, refit_start, false).detections;
+    // With edge refinement, the corners a fitted board lacks are predicted through the fit
+    // and kept where a junction is there (calib/checkerboard_completion.h).
+    if (checkerboard) {
+      const DetectionSet to_refine =
+          options.checkerboard_edges ? WithPredictedCheckerCorners(input.target, *refit_start, views.detections, fit, found)
+                                     : found;
+      detections = CheckerboardsRefinedThrough(input, options, *refit_start, to_refine);
+    } else {
+      detections = FindCorners(input, options, refit_start, false).detections;
+    }
     // The skipped views are named again by this pass's ViewsForFit.
     warnings.erase(std::remove_if(warnings.begin(), warnings.end(),
                                   [](const CalibrationWarning& w) { return w.code == WarningCode::kViewSkipped; }),

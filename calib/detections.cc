@@ -62,6 +62,7 @@ DetectionSet ReadDetections(const std::string& path) {
           throw InputError(InputMessage(path, where, "corner " + std::to_string(c.id) + "'s pixel must be [u, v]"));
         c.pixel = Eigen::Vector2d(pixel[0].get<double>(), pixel[1].get<double>());
         c.unrefined = corner.contains("refined") && !corner.at("refined").get<bool>();
+        c.predicted = corner.contains("predicted") && corner.at("predicted").get<bool>();
         if (!std::isfinite(c.pixel.x()) || !std::isfinite(c.pixel.y()))
           throw InputError(InputMessage(path, where, "corner " + std::to_string(c.id) + " has a non-finite pixel"));
         // A detector's corner lies in its image; one an image size beyond it is corrupt (and
@@ -97,6 +98,7 @@ void WriteDetections(const DetectionSet& detections, const std::string& path) {
     for (const CornerObservation& c : image.corners) {
       nlohmann::json corner = {{"id", c.id}, {"pixel", {c.pixel.x(), c.pixel.y()}}};
       if (c.unrefined) corner["refined"] = false;
+      if (c.predicted) corner["predicted"] = true;
       entry["corners"].push_back(corner);
     }
     json["images"].push_back(entry);

@@ -16,6 +16,9 @@ struct CornerObservation {
   // neighbour missing): the detector's own position, 0.1-9 px off on renders instead of
   // ~0.05. Kept so the detection is not lost; `omnical calibrate` leaves it out of the fit.
   bool unrefined = false;
+  // Placed by a prediction, not by a detector (calib/checkerboard_completion.h): dropped
+  // unless its refinement succeeds.
+  bool predicted = false;
 };
 
 struct ImageDetections {
@@ -32,8 +35,9 @@ struct DetectionSet {
 
 // JSON: {"target": spec, "image_size": [W, H], "images": [{"image": path,
 // "corners": [{"id": i, "pixel": [u, v]}, ...]}, ...]}; an unrefined corner also has
-// "refined": false; "target_description" (optional) describes the board the corners were
-// found on (CalibrationTarget::Describe). Read throws InputError naming the
+// "refined": false, one placed by a prediction through a fit and confirmed by its
+// refinement "predicted": true; "target_description" (optional) describes the board the
+// corners were found on (CalibrationTarget::Describe). Read throws InputError naming the
 // file and the entry; write is atomic.
 DetectionSet ReadDetections(const std::string& path);
 void WriteDetections(const DetectionSet& detections, const std::string& path);

@@ -399,6 +399,9 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
     if (moved) {
       corner.pixel = refined;
       ++local.refined;
+    } else if (corner.predicted) {
+      ++local.predictions_dropped;
+      continue;  // no junction where the fit predicted one
     } else if (guess && target.type() == CalibrationTarget::Type::kAprilGrid) {
       corner.unrefined = true;
       ++local.unrefined;

@@ -16,6 +16,7 @@
 #include <set>
 
 #include "calib/checkerboard_candidates.h"
+#include "calib/checkerboard_completion.h"
 #include "calib/detect.h"
 #include "calib/partial_checkerboard.h"
 #include "calib/virtual_view.h"
@@ -945,6 +946,70 @@ TEST(PartialCheckerboard, PlacesABoardThatSpansItsExtentOnly) {
 
   const cv::Mat tiles = FlatBoard(16, 12, cv::Point(24, 24), cv::Size(400, 320));
   EXPECT_FALSE(FindPartialCheckerboard(tiles, pattern));
+}
+
+}  // namespace
+}  // namespace omnical
+
+namespace omnical {
+namespace {
+
+// Corners a fitted view lacks, predicted through the fit (calib/checkerboard_completion.h):
+// with the true sensor, poses and warp as the "fit", each missing corner the truth sees is
+// placed on its exact pixel (1e-6 px: the same projection, the warp's offset along the
+// board's normal as the renderer bends it), marked predicted; the corners a view has are not
+// touched, a view the fit left out gets none, and an aprilgrid gets none.
+TEST(CheckerboardCompletion, PredictsTheMissingCornersThroughTheFit) {
+  const Scene scene = LoadSceneYaml(testing::SourceDir() + "/datasets-synthetic/scenes/realistic-checkerboard.yaml");
+  const Sensor& sensor = *scene.sensor;
+  const CalibrationTarget& target = *scene.views[0].targets[0].target;
+  DetectionSet fitted;
+  FitResult fit;
+  fit.board_warp = BoardWarpEstimate{scene.views[0].targets[0].surface.warp};
+  ASSERT_FALSE(fit.board_warp->warp.IsZero());
+  std::map<std::string, std::map<int, Eigen::Vector2d>> truth_px;
+  const std::set<int> removed = {0, 9, 20, 47};
+  for (size_t v = 0; v < 3; ++v) {
+    const SceneView& view = scene.views[v];
+    ImageDetections image;
+    image.image = view.name;
+    const std::vector<TargetTruth> view_truth = GroundTruth(sensor, view);
+    for (const CornerTruth& c : view_truth[0].corners) {
+      if (!c.visible) continue;
+      truth_px[view.name][c.id] = c.pixel;
+      if (!removed.count(c.id)) image.corners.push_back({c.id, c.pixel + Eigen::Vector2d(0.25, 0.0)});
+    }
+    fitted.images.push_back(image);
+    const PlacedTarget& placed = view.targets[0];
+    fit.poses.push_back(
+        {Eigen::Quaterniond(placed.camera_from_target_rotation), placed.camera_from_target_translation_mm});
+    fit.view_left_out.push_back(v == 2 ? "left out" : "");
+  }
+  const DetectionSet completed = WithPredictedCheckerCorners(target, sensor, fitted, fit, fitted);
+  ASSERT_EQ(completed.images.size(), 3u);
+  for (size_t v = 0; v < 3; ++v) {
+    const ImageDetections& image = completed.images[v];
+    const auto& truth = truth_px[image.image];
+    int predicted = 0;
+    for (const CornerObservation& c : image.corners) {
+      if (!c.predicted) {
+        EXPECT_NEAR((c.pixel - truth.at(c.id)).norm(), 0.25, 1e-12) << image.image << " corner " << c.id << " moved";
+        continue;
+      }
+      ++predicted;
+      EXPECT_TRUE(removed.count(c.id)) << image.image << " corner " << c.id;
+      ASSERT_TRUE(truth.count(c.id)) << image.image << " corner " << c.id << " predicted where the truth sees none";
+      EXPECT_LT((c.pixel - truth.at(c.id)).norm(), 1e-6) << image.image << " corner " << c.id;
+    }
+    int expected = 0;
+    for (int id : removed) expected += truth.count(id);
+    EXPECT_GE(expected, 2) << image.image << ": the removed corners should be visible there";
+    EXPECT_EQ(predicted, v == 2 ? 0 : expected) << image.image;
+  }
+  const CalibrationTarget aprilgrid =
+      CalibrationTarget::FromYaml(testing::SourceDir() + "/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml");
+  EXPECT_EQ(WithPredictedCheckerCorners(aprilgrid, sensor, fitted, fit, fitted).images[0].corners.size(),
+            fitted.images[0].corners.size());
 }
 
 }  // namespace

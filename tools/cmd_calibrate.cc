@@ -31,7 +31,8 @@ const FlagTable kFlags = {{"fixed", "--fix"}, {"robust_loss_px", "--loss-px"}, {
                           {"detection_passes", "--detection-passes"}, {"distances_mm", "--distance-mm"},
                           {"distances_n", "--distance-n"}, {"max_predicted_error_px", "--max-predicted-error-px"},
                           {"holdout_views", "--holdout"}, {"holdout", "--holdout"}, {"cross_validate", "--cross-validate"},
-                          {"cross_validation_distance_mm", "--cross-validate-distance-mm"}, {"knots", "--knots"}};
+                          {"cross_validation_distance_mm", "--cross-validate-distance-mm"}, {"knots", "--knots"},
+                          {"checkerboard_edges", "--checkerboard-edges"}};
 
 void RunCalibrate(CalibrateFlags options, const Context& context) {
   CalibrationInput input;

@@ -462,6 +462,9 @@ def test_detect_cancel_and_bad_options(few):
         omnical.detect(3.5, few)
     with pytest.raises(omnical.InputError, match="^checkerboard_edges/guess: the corners are refined by their edges"):
         omnical.detect(TARGET, few, checkerboard_edges=True)
+    # calibrate says it too, before any detection: the option would do nothing there.
+    with pytest.raises(omnical.InputError, match="^checkerboard_edges: the target is not a checkerboard"):
+        omnical.calibrate(TARGET, few, guess=GUESS, checkerboard_edges=True)
 
 
 # --- bad input: the CLI's messages ---------------------------------------------------------

@@ -1,0 +1,41 @@
+#include "calib/checkerboard_completion.h"
+
+#include <map>
+#include <set>
+
+#include "calib/board_warp.h"
+
+namespace omnical {
+
+DetectionSet WithPredictedCheckerCorners(const CalibrationTarget& target, const Sensor& sensor,
+                                         const DetectionSet& fitted, const FitResult& fit, DetectionSet found) {
+  if (target.type() != CalibrationTarget::Type::kCheckerboard) return found;
+  const BoardWarp warp = fit.board_warp ? fit.board_warp->warp : BoardWarp{};
+  const std::map<int, Eigen::Vector2d> basis = BoardWarp::Basis(target);
+  std::map<std::string, ImageDetections*> by_name;
+  for (ImageDetections& image : found.images) by_name[image.image] = &image;
+  for (size_t v = 0; v < fitted.images.size() && v < fit.poses.size(); ++v) {
+    if (v < fit.view_left_out.size() && !fit.view_left_out[v].empty()) continue;
+    const auto it = by_name.find(fitted.images[v].image);
+    if (it == by_name.end()) continue;
+    ImageDetections& image = *it->second;
+    std::set<int> have;
+    for (const CornerObservation& c : image.corners) have.insert(c.id);
+    const TargetPose& pose = fit.poses[v];
+    for (const TargetCorner& corner : target.corners()) {
+      if (have.count(corner.id)) continue;
+      Eigen::Vector3d in_target = corner.point_in_target;
+      if (const auto b = basis.find(corner.id); b != basis.end()) in_target.z() += warp.OffsetMm(b->second);
+      const Eigen::Vector3d in_camera =
+          pose.camera_from_target_rotation * in_target + pose.camera_from_target_translation_mm;
+      Eigen::Vector2d pixel;
+      if (sensor.Project(in_camera, &pixel) != ProjectionStatus::kOk) continue;
+      CornerObservation predicted{corner.id, pixel};
+      predicted.predicted = true;
+      image.corners.push_back(predicted);
+    }
+  }
+  return found;
+}
+
+}  // namespace omnical
