@@ -319,8 +319,10 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     throw InputError("checkerboard_edges: refines the corners found in images, not corners given as detections "
                      "(detect --sensor ... --checkerboard-edges refines them there)");
   if (options.checkerboard_edges && input.target.type() != CalibrationTarget::Type::kCheckerboard)
-    throw InputError("checkerboard_edges: the target is not a checkerboard (an aprilgrid's corners are refined by "
-                     "their edges always)");
+    throw InputError("checkerboard_edges: the target is not a checkerboard");
+  if (options.checkerboard_edges && options.detection_passes < 2)
+    throw InputError("checkerboard_edges/detection_passes: the corners are refined by their edges in the second "
+                     "detection pass: give 2 or more");
   std::vector<CalibrationWarning> warnings;
   CalibrationRecord record;
   std::vector<PredictedError> predicted;
@@ -466,12 +468,15 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     if (checkerboard && !FindMissedCheckerboards(input, options, *fit.sensor, &found) && pass > 2) break;
     refit_start = *fit.sensor;
     passes_run = pass;
-    // With edge refinement, the corners a fitted board lacks are predicted through the fit
-    // and kept where a junction is there (calib/checkerboard_completion.h).
+    // With edge refinement, the corners a fitted board lacks are predicted through this
+    // pass's start (the previous fit) and kept where a junction is there
+    // (calib/checkerboard_completion.h).
     if (checkerboard) {
       const DetectionSet to_refine =
-          options.checkerboard_edges ? WithPredictedCheckerCorners(input.target, *refit_start, views.detections, fit, found)
-                                     : found;
+          options.checkerboard_edges
+              ? WithPredictedCheckerCorners(input.target, *refit_start, fit.board_warp ? fit.board_warp->warp : BoardWarp{},
+                                            views.detections, fit, found)
+              : found;
       detections = CheckerboardsRefinedThrough(input, options, *refit_start, to_refine);
     } else {
       detections = FindCorners(input, options, refit_start, false).detections;

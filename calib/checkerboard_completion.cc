@@ -2,20 +2,20 @@
 
 #include <map>
 #include <set>
-
-#include "calib/board_warp.h"
+#include <stdexcept>
 
 namespace omnical {
 
-DetectionSet WithPredictedCheckerCorners(const CalibrationTarget& target, const Sensor& sensor,
+DetectionSet WithPredictedCheckerCorners(const CalibrationTarget& target, const Sensor& sensor, const BoardWarp& warp,
                                          const DetectionSet& fitted, const FitResult& fit, DetectionSet found) {
   if (target.type() != CalibrationTarget::Type::kCheckerboard) return found;
-  const BoardWarp warp = fit.board_warp ? fit.board_warp->warp : BoardWarp{};
+  if (fit.poses.size() != fitted.images.size() || fit.view_left_out.size() != fitted.images.size())
+    throw std::logic_error("WithPredictedCheckerCorners: the fit describes other views than `fitted`");
   const std::map<int, Eigen::Vector2d> basis = BoardWarp::Basis(target);
   std::map<std::string, ImageDetections*> by_name;
   for (ImageDetections& image : found.images) by_name[image.image] = &image;
-  for (size_t v = 0; v < fitted.images.size() && v < fit.poses.size(); ++v) {
-    if (v < fit.view_left_out.size() && !fit.view_left_out[v].empty()) continue;
+  for (size_t v = 0; v < fitted.images.size(); ++v) {
+    if (!fit.view_left_out[v].empty()) continue;
     const auto it = by_name.find(fitted.images[v].image);
     if (it == by_name.end()) continue;
     ImageDetections& image = *it->second;

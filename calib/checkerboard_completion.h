@@ -1,4 +1,5 @@
-// Checkerboard corners the detector missed, predicted through a fit. OpenCV's detector and
+// Checkerboard corners the detector missed, predicted through a fit (calibrate's previous
+// pass). OpenCV's detector and
 // the partial-board search need whole squares around a junction, so where the mirror's rim
 // cuts a board the outer row of junctions shows but is not found (the realistic
 // checkerboard render lost 13 of its 570 visible corners that way, every one on a row the
@@ -10,6 +11,7 @@
 // corner beyond the rim, behind a hand) finds no such junction and is dropped.
 #pragma once
 
+#include "calib/board_warp.h"
 #include "calib/bundle_fit.h"
 #include "calib/detections.h"
 #include "calib/target.h"
@@ -17,10 +19,12 @@
 
 namespace omnical {
 
-// `found` with the corners each view of `fitted` (the views `fit` was given, in its order)
-// lacks added as predictions (`predicted`), for the views the fit kept. `found` as it is
-// for another target type.
-DetectionSet WithPredictedCheckerCorners(const CalibrationTarget& target, const Sensor& sensor,
+// `found` with predictions (`predicted`) added to the image of each view of `fitted` (the
+// views `fit` was given, in its order; matched to `found` by image name) that the fit kept:
+// every board corner that image of `found` lacks, through `sensor`, the view's fitted pose
+// and `warp` (the board's: fitted or held). `found` as it is for another target type.
+// Throws std::logic_error when `fit` does not describe `fitted`'s views.
+DetectionSet WithPredictedCheckerCorners(const CalibrationTarget& target, const Sensor& sensor, const BoardWarp& warp,
                                          const DetectionSet& fitted, const FitResult& fit, DetectionSet found);
 
 }  // namespace omnical

@@ -2,6 +2,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <functional>
 
 #include "calib/detect.h"
@@ -141,8 +142,13 @@ DetectionSet RefineFoundCorners(const CalibrationTarget& target, const Detection
   DetectionSet out = found;
   PerImage(found.images.size(), options, "refine", [&](size_t i) {
     const cv::Mat grey = image_of(found.images[i].image);
-    if (!grey.empty() && grey.type() == CV_8UC1)
+    if (!grey.empty() && grey.type() == CV_8UC1) {
       out.images[i] = Refined(target, grey, GuessFor(grey, options), options, found.images[i]);
+    } else {  // predictions stand only once refined
+      auto& corners = out.images[i].corners;
+      corners.erase(std::remove_if(corners.begin(), corners.end(), [](const CornerObservation& c) { return c.predicted; }),
+                    corners.end());
+    }
   });
   return out;
 }

@@ -396,12 +396,12 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
         moved = RefineInImage(target, image, centre, neighbours, by_edges, &refined_patch) && patch.ToOmni(refined_patch, &refined);
       }
     }
+    // A prediction stands only where the edges show a junction (a window method such as
+    // cornerSubPix settles on anything with a gradient).
+    if (corner.predicted && !(moved && by_edges)) continue;
     if (moved) {
       corner.pixel = refined;
       ++local.refined;
-    } else if (corner.predicted) {
-      ++local.predictions_dropped;
-      continue;  // no junction where the fit predicted one
     } else if (guess && target.type() == CalibrationTarget::Type::kAprilGrid) {
       corner.unrefined = true;
       ++local.unrefined;

@@ -39,8 +39,6 @@ struct CornerRefinementStats {
   // neighbour missing) keep the detector's position marked `unrefined`: it is ~5x worse
   // (0.1-9 px on renders) and, unweighted among refined ones, biased the fit's mirror size.
   int unrefined = 0;
-  // Predicted corners (CornerObservation::predicted) whose refinement failed: dropped.
-  int predictions_dropped = 0;
 };
 
 // A checkerboard's cornerSubPix window on a grid step under this (omni px) holds too few

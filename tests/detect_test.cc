@@ -985,8 +985,14 @@ TEST(CheckerboardCompletion, PredictsTheMissingCornersThroughTheFit) {
         {Eigen::Quaterniond(placed.camera_from_target_rotation), placed.camera_from_target_translation_mm});
     fit.view_left_out.push_back(v == 2 ? "left out" : "");
   }
-  const DetectionSet completed = WithPredictedCheckerCorners(target, sensor, fitted, fit, fitted);
-  ASSERT_EQ(completed.images.size(), 3u);
+  // `found` holds the images in another order, and one the fit did not see: matched by name.
+  DetectionSet found = fitted;
+  std::reverse(found.images.begin(), found.images.end());
+  found.images.push_back(ImageDetections{"not-fitted.png", {}});
+  const DetectionSet completed =
+      WithPredictedCheckerCorners(target, sensor, fit.board_warp->warp, fitted, fit, found);
+  ASSERT_EQ(completed.images.size(), 4u);
+  EXPECT_TRUE(completed.images[3].corners.empty());
   for (size_t v = 0; v < 3; ++v) {
     const ImageDetections& image = completed.images[v];
     const auto& truth = truth_px[image.image];
@@ -1004,12 +1010,14 @@ TEST(CheckerboardCompletion, PredictsTheMissingCornersThroughTheFit) {
     int expected = 0;
     for (int id : removed) expected += truth.count(id);
     EXPECT_GE(expected, 2) << image.image << ": the removed corners should be visible there";
-    EXPECT_EQ(predicted, v == 2 ? 0 : expected) << image.image;
+    EXPECT_EQ(predicted, image.image == scene.views[2].name ? 0 : expected) << image.image;
   }
   const CalibrationTarget aprilgrid =
       CalibrationTarget::FromYaml(testing::SourceDir() + "/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml");
-  EXPECT_EQ(WithPredictedCheckerCorners(aprilgrid, sensor, fitted, fit, fitted).images[0].corners.size(),
+  EXPECT_EQ(WithPredictedCheckerCorners(aprilgrid, sensor, fit.board_warp->warp, fitted, fit, fitted).images[0].corners.size(),
             fitted.images[0].corners.size());
+  fit.poses.pop_back();
+  EXPECT_THROW(WithPredictedCheckerCorners(target, sensor, fit.board_warp->warp, fitted, fit, fitted), std::logic_error);
 }
 
 }  // namespace
