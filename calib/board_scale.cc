@@ -87,10 +87,7 @@ Fitted FitAtScale(const std::vector<ScaledCornerError>& corners, const TargetPos
 BoardScale CheckBoardScale(const Sensor& sensor, const CalibrationTarget& target, const ImageDetections& image,
                            const TargetPose& pose, double sigma_px, const BoardScaleOptions& options,
                            const BoardWarp& warp) {
-  std::map<int, Eigen::Vector3d> points;
-  for (const TargetCorner& c : target.corners()) points[c.id] = c.point_in_target;
-  if (!warp.IsZero())  // along the board's normal, as the bundle fit's cost bends it
-    for (const auto& [id, basis] : BoardWarp::Basis(target)) points[id].z() += warp.OffsetMm(basis);
+  const std::map<int, Eigen::Vector3d> points = warp.CornerPoints(target);
   std::vector<ScaledCornerError> corners;
   for (const CornerObservation& c : image.corners) {
     const auto point = points.find(c.id);

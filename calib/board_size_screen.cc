@@ -5,13 +5,6 @@
 #include "model/parallel_rows.h"
 
 namespace omnical {
-namespace {
-
-BoardWarp WarpOf(const FitResult& fit, const FitOptions& fit_options) {
-  return fit.board_warp ? fit.board_warp->warp : fit_options.board_warp;
-}
-
-}  // namespace
 
 BoardSizeScreen ScreenBoardSizes(const Sensor& start, const CalibrationTarget& target, const DetectionSet& detections,
                                  const FitResult& fit, const FitOptions& fit_options,

@@ -48,4 +48,12 @@ std::map<int, Eigen::Vector2d> BoardWarp::Basis(const CalibrationTarget& target)
   return basis;
 }
 
+std::map<int, Eigen::Vector3d> BoardWarp::CornerPoints(const CalibrationTarget& target) const {
+  std::map<int, Eigen::Vector3d> points;
+  for (const TargetCorner& c : target.corners()) points[c.id] = c.point_in_target;
+  if (!IsZero())
+    for (const auto& [id, basis] : Basis(target)) points[id].z() += OffsetMm(basis);
+  return points;
+}
+
 }  // namespace omnical

@@ -19,6 +19,9 @@ struct BoardWarp {
 
   // Per corner id the factors (1 - u^2, 1 - v^2) the deflections multiply.
   static std::map<int, Eigen::Vector2d> Basis(const CalibrationTarget& target);
+  // Per corner id its point on the bent board (mm, target frame): the printed point moved
+  // along the board's normal by its offset, as the bundle fit's cost bends it.
+  std::map<int, Eigen::Vector3d> CornerPoints(const CalibrationTarget& target) const;
   // The out-of-plane offset of a corner with that basis (mm).
   double OffsetMm(const Eigen::Vector2d& basis) const { return x_mm * basis.x() + y_mm * basis.y(); }
   bool IsZero() const { return x_mm == 0.0 && y_mm == 0.0; }

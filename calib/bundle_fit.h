@@ -129,6 +129,11 @@ Sensor SensorWithParameters(const Sensor& sensor, const std::vector<double>& val
 bool InitialTargetPose(const Sensor& sensor, const CalibrationTarget& target, const ImageDetections& image,
                        TargetPose* pose);
 
+// The board's warp a fit ran with: fitted, else the one `options` held.
+inline BoardWarp WarpOf(const FitResult& fit, const FitOptions& options) {
+  return fit.board_warp ? fit.board_warp->warp : options.board_warp;
+}
+
 // Fits from `guess` and the initial poses (one per detections.images entry).
 FitResult FitSensor(const Sensor& guess, const CalibrationTarget& target, const DetectionSet& detections,
                     const std::vector<TargetPose>& initial_poses, const FitOptions& options);

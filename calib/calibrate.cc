@@ -474,8 +474,8 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     if (checkerboard) {
       const DetectionSet to_refine =
           options.checkerboard_edges
-              ? WithPredictedCheckerCorners(input.target, *refit_start, fit.board_warp ? fit.board_warp->warp : BoardWarp{},
-                                            views.detections, fit, found)
+              ? WithPredictedCheckerCorners(input.target, *refit_start, WarpOf(fit, fit_options), views.detections, fit,
+                                            found)
               : found;
       detections = CheckerboardsRefinedThrough(input, options, *refit_start, to_refine);
     } else {

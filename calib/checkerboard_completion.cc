@@ -11,7 +11,7 @@ DetectionSet WithPredictedCheckerCorners(const CalibrationTarget& target, const 
   if (target.type() != CalibrationTarget::Type::kCheckerboard) return found;
   if (fit.poses.size() != fitted.images.size() || fit.view_left_out.size() != fitted.images.size())
     throw std::logic_error("WithPredictedCheckerCorners: the fit describes other views than `fitted`");
-  const std::map<int, Eigen::Vector2d> basis = BoardWarp::Basis(target);
+  const std::map<int, Eigen::Vector3d> points = warp.CornerPoints(target);
   std::map<std::string, ImageDetections*> by_name;
   for (ImageDetections& image : found.images) by_name[image.image] = &image;
   for (size_t v = 0; v < fitted.images.size(); ++v) {
@@ -22,15 +22,13 @@ DetectionSet WithPredictedCheckerCorners(const CalibrationTarget& target, const 
     std::set<int> have;
     for (const CornerObservation& c : image.corners) have.insert(c.id);
     const TargetPose& pose = fit.poses[v];
-    for (const TargetCorner& corner : target.corners()) {
-      if (have.count(corner.id)) continue;
-      Eigen::Vector3d in_target = corner.point_in_target;
-      if (const auto b = basis.find(corner.id); b != basis.end()) in_target.z() += warp.OffsetMm(b->second);
+    for (const auto& [id, in_target] : points) {
+      if (have.count(id)) continue;
       const Eigen::Vector3d in_camera =
           pose.camera_from_target_rotation * in_target + pose.camera_from_target_translation_mm;
       Eigen::Vector2d pixel;
       if (sensor.Project(in_camera, &pixel) != ProjectionStatus::kOk) continue;
-      CornerObservation predicted{corner.id, pixel};
+      CornerObservation predicted{id, pixel};
       predicted.predicted = true;
       image.corners.push_back(predicted);
     }

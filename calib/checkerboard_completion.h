@@ -1,9 +1,8 @@
 // Checkerboard corners the detector missed, predicted through a fit (calibrate's previous
-// pass). OpenCV's detector and
-// the partial-board search need whole squares around a junction, so where the mirror's rim
-// cuts a board the outer row of junctions shows but is not found (the realistic
-// checkerboard render lost 13 of its 570 visible corners that way, every one on a row the
-// rim cuts). Each board corner a fitted view lacks is projected through the fitted sensor
+// pass). OpenCV's detector and the partial-board search need whole squares around a
+// junction, so where the mirror's rim cuts a board the outer row of junctions shows but is
+// not found (the realistic checkerboard render lost 13 of its 570 visible corners that way,
+// every one on a row the rim cuts). Each board corner a fitted view lacks is projected through the fitted sensor
 // and its board's pose and warp, marked `predicted`, and kept only where its refinement by
 // edges (CheckerRefinement::kEdges, calib/refine_corners.h) succeeds: both grid lines
 // through the junction found on both sides of it, smooth to a small fraction of a square,
