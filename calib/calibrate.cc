@@ -156,10 +156,11 @@ std::optional<RimCircle> RimOfImages(const DetectionSet& detections) {
 // The corners, detected here (with the rim circles when there is no guess) or given.
 DetectedImages FindCorners(const CalibrationInput& input, const CalibrationOptions& options,
                            const std::optional<Sensor>& through, bool rim_circles, bool omni_search = true,
-                           bool refine = true) {
+                           bool refine = true, bool fit_whole_tags = true) {
   DetectionOptions detection;
   detection.guess = through;
   detection.refine = refine;
+  detection.fit_whole_tags = fit_whole_tags;
   detection.rim_circles = rim_circles;
   detection.threads = options.threads;
   detection.progress = options.progress;
@@ -330,9 +331,13 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   DetectionSet detections;
   std::optional<RimCircle> rim;
   if (from_images) {
-    // Checkerboard corners are refined in the second pass, through the first fit.
+    // Checkerboard corners are refined in the second pass, through the first fit; aprilgrid
+    // tags are fitted whole (calib/tag_template_fit.h) only in the pass whose corners are
+    // kept: these only start the first fit when a second pass follows (the whole-tag fits
+    // are three quarters of a detection's time).
     DetectedImages found = FindCorners(input, options, input.guess, !input.guess, true,
-                                       input.target.type() != CalibrationTarget::Type::kCheckerboard);
+                                       input.target.type() != CalibrationTarget::Type::kCheckerboard,
+                                       options.detection_passes < 2);
     detections = std::move(found.detections);
     warnings = std::move(found.warnings);
     if (!input.guess) rim = MedianRimCircle(found.rim_circles);

@@ -35,7 +35,8 @@ ImageDetections Refined(const CalibrationTarget& target, const cv::Mat& grey, co
   if (!options.refine && !(checkerboard && (options.refine_checkerboards || options.checkerboard_edges))) return found;
   return RefineCorners(target, grey, guess, found, nullptr,
                        checkerboard && !options.refine_checkerboards ? kMinRefinedCheckerStepPx : 0.0,
-                       options.checkerboard_edges ? CheckerRefinement::kEdges : CheckerRefinement::kSubPixel);
+                       options.checkerboard_edges ? CheckerRefinement::kEdges : CheckerRefinement::kSubPixel,
+                       options.fit_whole_tags);
 }
 
 void DetectOne(const CalibrationTarget& target, const cv::Mat& grey, const DetectionOptions& options, OneImage* out) {

@@ -30,6 +30,8 @@ struct DetectionOptions {
   bool refine_checkerboards = false;
   // With a guess: checkerboard corners refined by their edges, every one (calib/refine_corners.h).
   bool checkerboard_edges = false;
+  // With a guess: aprilgrid tags fitted whole (calib/tag_template_fit.h) after the edge profiles.
+  bool fit_whole_tags = true;
   bool rim_circles = false;
   // false: with a guess, search its virtual views only (images the omni image's search
   // already missed: a second pass through a fitted sensor).

@@ -3,10 +3,12 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 
 #include "calib/bilinear.h"
+#include "calib/tag_template_fit.h"
 #include "calib/virtual_view.h"
 
 namespace omnical {
@@ -305,7 +307,7 @@ double ReachOf(const CalibrationTarget& target, CheckerRefinement checker_refine
 
 ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& grey, const Sensor* guess,
                               const ImageDetections& detections, CornerRefinementStats* stats,
-                              double min_checker_step_px, CheckerRefinement checker_refinement) {
+                              double min_checker_step_px, CheckerRefinement checker_refinement, bool fit_whole_tags) {
   const bool by_edges = guess && checker_refinement == CheckerRefinement::kEdges;
   CornerRefinementStats local;
   std::map<int, Eigen::Vector2d> by_id;
@@ -409,6 +411,38 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
       ++local.kept;
     }
     out.corners.push_back(corner);
+  }
+  // Aprilgrid tags whose four corners were found: the whole tag's pattern fitted to its
+  // pixels (calib/tag_template_fit.h) from where the edge profiles (or the detector) put
+  // them. A fit whose residual is far above the image's typical one settled in another
+  // minimum (the bits one column over): those tags keep the corners above.
+  if (guess && fit_whole_tags && target.type() == CalibrationTarget::Type::kAprilGrid) {
+    std::map<int, std::array<int, 4>> tags;  // tag id -> index in out.corners per k
+    for (size_t i = 0; i < out.corners.size(); ++i) {
+      auto entry = tags.try_emplace(out.corners[i].id / 4, std::array<int, 4>{-1, -1, -1, -1}).first;
+      entry->second[out.corners[i].id % 4] = static_cast<int>(i);
+    }
+    std::vector<std::pair<std::array<int, 4>, TagTemplateFit>> fits;
+    for (const auto& [tag, index] : tags) {
+      if (std::count(index.begin(), index.end(), -1) > 0) continue;
+      std::array<Eigen::Vector2d, 4> start;
+      for (int k = 0; k < 4; ++k) start[k] = out.corners[index[k]].pixel;
+      if (TagTemplateFit fit; FitTagTemplate(target, grey, *guess, tag, start, &fit)) fits.push_back({index, fit});
+    }
+    std::vector<double> relative;
+    for (const auto& [index, fit] : fits) relative.push_back(fit.rms_grey / fit.contrast);
+    if (!relative.empty()) {
+      std::nth_element(relative.begin(), relative.begin() + relative.size() / 2, relative.end());
+      const double typical = relative[relative.size() / 2];
+      for (const auto& [index, fit] : fits) {
+        if (fit.rms_grey / fit.contrast > 2.5 * typical) continue;
+        for (int k = 0; k < 4; ++k) {
+          CornerObservation& corner = out.corners[index[k]];
+          corner.pixel = fit.corners_px[k];
+          if (corner.unrefined) corner.unrefined = false, --local.unrefined, ++local.refined;
+        }
+      }
+    }
   }
   if (stats) *stats = local;
   return out;

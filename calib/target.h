@@ -60,6 +60,9 @@ class CalibrationTarget {
   double Reflectance(double x_mm, double y_mm) const;
   static constexpr double kInk = 0.04;
   static constexpr double kPaper = 0.9;
+  // Black cells of the print as rectangles (x, y, w, h in mm), merged along rows: the
+  // printed face is kInk inside them and kPaper elsewhere on the board.
+  std::vector<Eigen::Vector4d> InkRectangles() const;
 
   // Printable versions at true scale. PNG at `dpi`; SVG and PDF as vector rectangles with
   // the physical size. Written atomically; throw InputError on failure.
@@ -74,8 +77,6 @@ class CalibrationTarget {
     std::vector<uint8_t> white;  // size x size, row 0 at the top of the printed tag
   };
   void BuildCorners();
-  // Black cells of the print as rectangles (x, y, w, h in mm), merged along rows.
-  std::vector<Eigen::Vector4d> InkRectangles() const;
 
   Type type_ = Type::kCheckerboard;
   std::string family_;
