@@ -484,7 +484,8 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
               : found;
       detections = CheckerboardsRefinedThrough(input, options, *refit_start, to_refine);
     } else {
-      detections = FindCorners(input, options, refit_start, false).detections;
+      detections = FindCorners(input, options, refit_start, false, true, true,
+                               /*fit_whole_tags=*/pass == options.detection_passes).detections;
     }
     // The skipped views are named again by this pass's ViewsForFit.
     warnings.erase(std::remove_if(warnings.begin(), warnings.end(),

@@ -415,10 +415,12 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
   // Aprilgrid tags whose four corners were found: the whole tag's pattern fitted to its
   // pixels (calib/tag_template_fit.h) from where the edge profiles (or the detector) put
   // them. A fit whose residual is far above the image's typical one settled in another
-  // minimum (the bits one column over): those tags keep the corners above.
+  // minimum (the bits one column over): those tags keep the corners above, as do all of an
+  // image with under 3 fitted tags.
   if (guess && fit_whole_tags && target.type() == CalibrationTarget::Type::kAprilGrid) {
     std::map<int, std::array<int, 4>> tags;  // tag id -> index in out.corners per k
     for (size_t i = 0; i < out.corners.size(); ++i) {
+      if (out.corners[i].id < 0) continue;  // not a tag's (the fit would find no such tag)
       auto entry = tags.try_emplace(out.corners[i].id / 4, std::array<int, 4>{-1, -1, -1, -1}).first;
       entry->second[out.corners[i].id % 4] = static_cast<int>(i);
     }
@@ -429,9 +431,10 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
       for (int k = 0; k < 4; ++k) start[k] = out.corners[index[k]].pixel;
       if (TagTemplateFit fit; FitTagTemplate(target, grey, *guess, tag, start, &fit)) fits.push_back({index, fit});
     }
+    // The median needs a few fits to say what is typical: with fewer, none is trusted.
     std::vector<double> relative;
     for (const auto& [index, fit] : fits) relative.push_back(fit.rms_grey / fit.contrast);
-    if (!relative.empty()) {
+    if (relative.size() >= 3) {
       std::nth_element(relative.begin(), relative.begin() + relative.size() / 2, relative.end());
       const double typical = relative[relative.size() / 2];
       for (const auto& [index, fit] : fits) {
