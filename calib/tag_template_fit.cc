@@ -4,13 +4,12 @@
 #include <ceres/rotation.h>
 
 #include <Eigen/Geometry>
-#include <opencv2/calib3d.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-#include "calib/virtual_view.h"
+#include "calib/bundle_fit.h"
 #include "model/scalar.h"
 
 namespace omnical {
@@ -85,43 +84,41 @@ class TagResidual {
     const T residual_variance = T(kResidualBlurFraction) * variance_px2;
     const T node_px = sqrt(T(3.0) * (variance_px2 - residual_variance));
     constexpr double kNodeWeights[3] = {1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0};
-    {
-      const size_t i = i_;
-      const std::array<int, 9>& ray = pixels_.rays[i];
-      T bx[9], by[9];
-      for (int j = 0; j < 9; ++j)
-        if (!board(ray[j], &bx[j], &by[j])) return false;
-      // pixel -> board to second order: board mm per omni px along u (a, c) and v (b, d),
-      // and the second derivatives.
-      const T a = T(0.5) * (bx[5] - bx[3]), c = T(0.5) * (by[5] - by[3]), b = T(0.5) * (bx[7] - bx[1]),
-              d = T(0.5) * (by[7] - by[1]);
-      const T uu_x = bx[5] + bx[3] - T(2.0) * bx[4], uu_y = by[5] + by[3] - T(2.0) * by[4];
-      const T vv_x = bx[7] + bx[1] - T(2.0) * bx[4], vv_y = by[7] + by[1] - T(2.0) * by[4];
-      const T uv_x = T(0.25) * (bx[8] - bx[6] - bx[2] + bx[0]), uv_y = T(0.25) * (by[8] - by[6] - by[2] + by[0]);
-      const T sx = sqrt(residual_variance * (a * a + b * b)), sy = sqrt(residual_variance * (c * c + d * d));
-      // Ink within 6 sigma on both axes (farther it adds under 1e-9): tested on the scalar
-      // parts before any erfc of a Jet.
-      const double reach_x = 6.0 * ScalarPart(sx), reach_y = 6.0 * ScalarPart(sy);
-      T coverage(0.0);
-      for (int ju = 0; ju < 3; ++ju)
-        for (int jv = 0; jv < 3; ++jv) {
-          const T du = T(ju - 1) * node_px, dv = T(jv - 1) * node_px;
-          const T x = bx[4] + a * du + b * dv + T(0.5) * (uu_x * du * du + vv_x * dv * dv) + uv_x * du * dv;
-          const T y = by[4] + c * du + d * dv + T(0.5) * (uu_y * du * du + vv_y * dv * dv) + uv_y * du * dv;
-          const double x0 = ScalarPart(x), y0 = ScalarPart(y);
-          T ink_here(0.0);
-          for (int k = pixels_.rectangle_begin[i]; k < pixels_.rectangle_begin[i + 1]; ++k) {
-            const Eigen::Vector4d& r = rectangles_[pixels_.rectangles[k]];
-            if (x0 < r(0) - reach_x || x0 > r(0) + r(2) + reach_x || y0 < r(1) - reach_y || y0 > r(1) + r(3) + reach_y)
-              continue;
-            ink_here += (cdf((T(r(0) + r(2)) - x) / sx) - cdf((T(r(0)) - x) / sx)) *
-                        (cdf((T(r(1) + r(3)) - y) / sy) - cdf((T(r(1)) - y) / sy));
-          }
-          coverage += T(kNodeWeights[ju] * kNodeWeights[jv]) * ink_here;
+    const size_t i = i_;
+    const std::array<int, 9>& ray = pixels_.rays[i];
+    T bx[9], by[9];
+    for (int j = 0; j < 9; ++j)
+      if (!board(ray[j], &bx[j], &by[j])) return false;
+    // pixel -> board to second order: board mm per omni px along u (a, c) and v (b, d),
+    // and the second derivatives.
+    const T a = T(0.5) * (bx[5] - bx[3]), c = T(0.5) * (by[5] - by[3]), b = T(0.5) * (bx[7] - bx[1]),
+            d = T(0.5) * (by[7] - by[1]);
+    const T uu_x = bx[5] + bx[3] - T(2.0) * bx[4], uu_y = by[5] + by[3] - T(2.0) * by[4];
+    const T vv_x = bx[7] + bx[1] - T(2.0) * bx[4], vv_y = by[7] + by[1] - T(2.0) * by[4];
+    const T uv_x = T(0.25) * (bx[8] - bx[6] - bx[2] + bx[0]), uv_y = T(0.25) * (by[8] - by[6] - by[2] + by[0]);
+    const T sx = sqrt(residual_variance * (a * a + b * b)), sy = sqrt(residual_variance * (c * c + d * d));
+    // Ink within 6 sigma on both axes (farther it adds under 1e-9): tested on the scalar
+    // parts before any erfc of a Jet.
+    const double reach_x = 6.0 * ScalarPart(sx), reach_y = 6.0 * ScalarPart(sy);
+    T coverage(0.0);
+    for (int ju = 0; ju < 3; ++ju)
+      for (int jv = 0; jv < 3; ++jv) {
+        const T du = T(ju - 1) * node_px, dv = T(jv - 1) * node_px;
+        const T x = bx[4] + a * du + b * dv + T(0.5) * (uu_x * du * du + vv_x * dv * dv) + uv_x * du * dv;
+        const T y = by[4] + c * du + d * dv + T(0.5) * (uu_y * du * du + vv_y * dv * dv) + uv_y * du * dv;
+        const double x0 = ScalarPart(x), y0 = ScalarPart(y);
+        T ink_here(0.0);
+        for (int k = pixels_.rectangle_begin[i]; k < pixels_.rectangle_begin[i + 1]; ++k) {
+          const Eigen::Vector4d& r = rectangles_[pixels_.rectangles[k]];
+          if (x0 < r(0) - reach_x || x0 > r(0) + r(2) + reach_x || y0 < r(1) - reach_y || y0 > r(1) + r(3) + reach_y)
+            continue;
+          ink_here += (cdf((T(r(0) + r(2)) - x) / sx) - cdf((T(r(0)) - x) / sx)) *
+                      (cdf((T(r(1) + r(3)) - y) / sy) - cdf((T(r(1)) - y) / sy));
         }
-      if (coverage > T(1.0)) coverage = T(1.0);
-      residuals[0] = paper + (ink - paper) * coverage - T(pixels_.grey[i]);
-    }
+        coverage += T(kNodeWeights[ju] * kNodeWeights[jv]) * ink_here;
+      }
+    if (coverage > T(1.0)) coverage = T(1.0);
+    residuals[0] = paper + (ink - paper) * coverage - T(pixels_.grey[i]);
     return true;
   }
 
@@ -143,43 +140,17 @@ bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const 
   if (have != 4) return false;
   const double cell_mm = target.tag_size_mm() / 8.0;
 
-  // The start pose: the corners' rays through a pinhole along the tag centre's ray (a
-  // central approximation; the fit then uses every pixel's own ray), its focal length the
-  // omni image's scale there.
-  std::array<Eigen::Vector3d, 4> origins, directions;
-  for (int k = 0; k < 4; ++k)
-    if (sensor.Unproject(start_px[k], &origins[k], &directions[k]) != ProjectionStatus::kOk) return false;
-  Eigen::Vector3d centre_origin, centre_direction;
-  const Eigen::Vector2d centre_px = 0.25 * (start_px[0] + start_px[1] + start_px[2] + start_px[3]);
-  if (sensor.Unproject(centre_px, &centre_origin, &centre_direction) != ProjectionStatus::kOk) return false;
-  double px_per_rad = 0.0, edge_px = 0.0;
-  for (int k = 0; k < 4; ++k) {
-    const int n = (k + 1) % 4;
-    const double angle_rad = std::acos(std::clamp(directions[k].dot(directions[n]), -1.0, 1.0));
-    if (!(angle_rad > 0.0)) return false;
-    px_per_rad = std::max(px_per_rad, (start_px[n] - start_px[k]).norm() / angle_rad);
-    edge_px = std::max(edge_px, (start_px[n] - start_px[k]).norm());
-  }
+  // The start pose: InitialTargetPose on the four corners (a central approximation; the
+  // fit then uses every pixel's own ray).
+  double edge_px = 0.0;
+  for (int k = 0; k < 4; ++k) edge_px = std::max(edge_px, (start_px[(k + 1) % 4] - start_px[k]).norm());
   if (!(edge_px >= 4.0 && edge_px <= 400.0)) return false;
-  const Eigen::Matrix3d frame = ViewFrame(centre_direction, -sensor.cache().camera_from_mirror_rotation.col(2));
-  std::vector<cv::Point3d> object;
-  std::vector<cv::Point2d> image;
-  for (int k = 0; k < 4; ++k) {
-    const Eigen::Vector3d in_view = frame.transpose() * directions[k];
-    if (!(in_view.z() > 0.0)) return false;
-    object.emplace_back(board_corners[k].x(), board_corners[k].y(), 0.0);
-    image.emplace_back(px_per_rad * in_view.x() / in_view.z(), px_per_rad * in_view.y() / in_view.z());
-  }
-  const cv::Matx33d pinhole(px_per_rad, 0.0, 0.0, 0.0, px_per_rad, 0.0, 0.0, 0.0, 1.0);
-  cv::Vec3d rvec, tvec;
-  if (!cv::solvePnP(object, image, pinhole, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE)) return false;
-  cv::Matx33d view_from_board;
-  cv::Rodrigues(rvec, view_from_board);
-  Eigen::Matrix3d rotation;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) rotation(r, c) = view_from_board(r, c);
-  rotation = frame * rotation;  // camera_from_board
-  const Eigen::Vector3d translation_mm = centre_origin + frame * Eigen::Vector3d(tvec[0], tvec[1], tvec[2]);
+  ImageDetections corners;
+  for (int k = 0; k < 4; ++k) corners.corners.push_back({4 * tag + k, start_px[k]});
+  TargetPose start_pose;
+  if (!InitialTargetPose(sensor, target, corners, &start_pose)) return false;
+  const Eigen::Matrix3d rotation = start_pose.camera_from_target_rotation.toRotationMatrix();  // camera_from_board
+  const Eigen::Vector3d translation_mm = start_pose.camera_from_target_translation_mm;
   auto board_point = [&](const Eigen::Matrix3d& camera_from_board, const Eigen::Vector3d& board_origin_mm,
                          const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Eigen::Vector2d* at) {
     const Eigen::Vector3d normal = camera_from_board.col(2);
@@ -245,12 +216,12 @@ bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const 
           all_on_mirror = all_on_mirror && on_mirror(i + dv * width + du);
         }
       if (!all_on_mirror) continue;
-      Eigen::Vector2d at;
       // The pixel's and its neighbours' rays must meet the plane in front (the cost refuses
-      // a step where one does not, and from the start none may).
+      // a step where one does not, and from the start none may); around[4] is the pixel.
+      Eigen::Vector2d at;
       bool all_meet = true;
       for (int j = 0; j < 9 && all_meet; ++j)
-        all_meet = board_point(rotation, translation_mm, pixels.origins[around[j]], pixels.directions[around[j]], &at);
+        if (j != 4) all_meet = board_point(rotation, translation_mm, pixels.origins[around[j]], pixels.directions[around[j]], &at);
       if (!all_meet || !board_point(rotation, translation_mm, pixels.origins[i], pixels.directions[i], &at)) continue;
       if ((at.array() < low_mm.array()).any() || (at.array() > high_mm.array()).any()) continue;
       pixels.grey.push_back(grey.at<uint8_t>(v0 + v, u0 + u));
