@@ -156,11 +156,12 @@ std::optional<RimCircle> RimOfImages(const DetectionSet& detections) {
 // The corners, detected here (with the rim circles when there is no guess) or given.
 DetectedImages FindCorners(const CalibrationInput& input, const CalibrationOptions& options,
                            const std::optional<Sensor>& through, bool rim_circles, bool omni_search = true,
-                           bool refine = true, bool fit_whole_tags = true) {
+                           bool refine = true, bool fit_whole_tags = true, const BoardWarp& warp = BoardWarp()) {
   DetectionOptions detection;
   detection.guess = through;
   detection.refine = refine;
   detection.fit_whole_tags = fit_whole_tags;
+  detection.board_warp = warp;
   detection.rim_circles = rim_circles;
   detection.threads = options.threads;
   detection.progress = options.progress;
@@ -201,10 +202,11 @@ bool FindMissedCheckerboards(const CalibrationInput& input, const CalibrationOpt
 
 // Checkerboard corners found without refinement, refined through a fitted sensor
 // (calib/image_detection.h, RefineFoundCorners).
-DetectionSet CheckerboardsRefinedThrough(const CalibrationInput& input, const CalibrationOptions& options,
-                                         const Sensor& through, const DetectionSet& found) {
+DetectionSet CornersRefinedThrough(const CalibrationInput& input, const CalibrationOptions& options,
+                                         const Sensor& through, const BoardWarp& warp, const DetectionSet& found) {
   DetectionOptions detection;
   detection.guess = through;
+  detection.board_warp = warp;
   detection.checkerboard_edges = options.checkerboard_edges;
   detection.threads = options.threads;
   detection.progress = options.progress;
@@ -473,19 +475,21 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     if (checkerboard && !FindMissedCheckerboards(input, options, *fit.sensor, &found) && pass > 2) break;
     refit_start = *fit.sensor;
     passes_run = pass;
-    // With edge refinement, the corners a fitted board lacks are predicted through this
-    // pass's start (the previous fit) and kept where a junction is there
-    // (calib/checkerboard_completion.h).
+    // The corners a fitted board lacks are predicted through this pass's start (the
+    // previous fit) and kept where a junction is there (calib/checkerboard_completion.h).
     if (checkerboard) {
-      const DetectionSet to_refine =
-          options.checkerboard_edges
-              ? WithPredictedCheckerCorners(input.target, *refit_start, WarpOf(fit, fit_options), views.detections, fit,
-                                            found)
-              : found;
-      detections = CheckerboardsRefinedThrough(input, options, *refit_start, to_refine);
+      detections = CornersRefinedThrough(
+          input, options, *refit_start, WarpOf(fit, fit_options),
+          WithPredictedCheckerCorners(input.target, *refit_start, WarpOf(fit, fit_options), views.detections, fit, found));
+    } else if (pass < options.detection_passes) {
+      detections = FindCorners(input, options, refit_start, false, true, true, /*fit_whole_tags=*/false).detections;
     } else {
-      detections = FindCorners(input, options, refit_start, false, true, true,
-                               /*fit_whole_tags=*/pass == options.detection_passes).detections;
+      // The last pass fits the tags whole, and the tags the rim cuts across it, from their
+      // corners predicted through the previous fit (calib/checkerboard_completion.h).
+      const DetectionSet raw = FindCorners(input, options, refit_start, false, true, /*refine=*/false).detections;
+      detections = CornersRefinedThrough(
+          input, options, *refit_start, WarpOf(fit, fit_options),
+          WithPredictedTagCorners(input.target, *refit_start, WarpOf(fit, fit_options), views.detections, fit, raw));
     }
     // The skipped views are named again by this pass's ViewsForFit.
     warnings.erase(std::remove_if(warnings.begin(), warnings.end(),

@@ -36,7 +36,7 @@ ImageDetections Refined(const CalibrationTarget& target, const cv::Mat& grey, co
   return RefineCorners(target, grey, guess, found, nullptr,
                        checkerboard && !options.refine_checkerboards ? kMinRefinedCheckerStepPx : 0.0,
                        options.checkerboard_edges ? CheckerRefinement::kEdges : CheckerRefinement::kSubPixel,
-                       options.fit_whole_tags);
+                       options.fit_whole_tags, options.board_warp);
 }
 
 void DetectOne(const CalibrationTarget& target, const cv::Mat& grey, const DetectionOptions& options, OneImage* out) {

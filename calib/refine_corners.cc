@@ -6,8 +6,10 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <set>
 
 #include "calib/bilinear.h"
+#include "calib/checker_junction_fit.h"
 #include "calib/tag_template_fit.h"
 #include "calib/virtual_view.h"
 
@@ -307,11 +309,16 @@ double ReachOf(const CalibrationTarget& target, CheckerRefinement checker_refine
 
 ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& grey, const Sensor* guess,
                               const ImageDetections& detections, CornerRefinementStats* stats,
-                              double min_checker_step_px, CheckerRefinement checker_refinement, bool fit_whole_tags) {
+                              double min_checker_step_px, CheckerRefinement checker_refinement, bool fit_whole_tags,
+                              const BoardWarp& warp) {
   const bool by_edges = guess && checker_refinement == CheckerRefinement::kEdges;
   CornerRefinementStats local;
   std::map<int, Eigen::Vector2d> by_id;
-  for (const CornerObservation& c : detections.corners) by_id[c.id] = c.pixel;
+  std::map<int, Eigen::Vector2d> detected_px;  // without the predictions
+  for (const CornerObservation& c : detections.corners) {
+    by_id[c.id] = c.pixel;
+    if (!c.predicted) detected_px[c.id] = c.pixel;
+  }
   // Rays of every corner (with a guess): the patch of a corner looks along its own ray,
   // and its neighbours' rays place them in the patch.
   std::map<int, std::pair<Eigen::Vector3d, Eigen::Vector3d>> rays;
@@ -327,13 +334,21 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
   ImageDetections out = detections;
   out.corners.clear();
   for (CornerObservation corner : detections.corners) {
+    // A tag's predicted corners stand or fall with the tag's fit across the rim (below).
+    if (corner.predicted && target.type() == CalibrationTarget::Type::kAprilGrid) {
+      out.corners.push_back(corner);
+      continue;
+    }
     const std::vector<int> neighbour_ids = NeighboursOf(target, corner.id);
+    // A prediction (calib/checkerboard_completion.h) by its edges in either mode: it stands
+    // only where they, or the squares fitted whole, show a junction.
+    const bool corner_by_edges = by_edges || (guess && corner.predicted);
     bool moved = false;
     Eigen::Vector2d refined;
     bool small_square = false;
     // Small squares: left to the detector for cornerSubPix (its window holds too few
     // pixels there), not for the edge fits (they run over a magnified square).
-    if (target.type() == CalibrationTarget::Type::kCheckerboard && min_checker_step_px > 0.0 && !by_edges) {
+    if (target.type() == CalibrationTarget::Type::kCheckerboard && min_checker_step_px > 0.0 && !corner_by_edges) {
       double omni_step_px = HUGE_VAL;
       for (int n : neighbour_ids)
         if (by_id.count(n)) omni_step_px = std::min(omni_step_px, (by_id[n] - corner.pixel).norm());
@@ -389,18 +404,22 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
       for (Eigen::Vector2d& n : neighbours) n *= focal;
       // Bounded: a corner whose neighbours sit absurdly far is not refined.
       if (omni_px_per_rad > 0.0 && std::isfinite(distance) && distance < 2000.0) {
-        const int half_size = static_cast<int>(std::ceil(ReachOf(target, checker_refinement) * distance)) + 4;
+        const int half_size = static_cast<int>(std::ceil(ReachOf(target, corner_by_edges ? CheckerRefinement::kEdges : checker_refinement) * distance)) + 4;
         const VirtualView patch(*guess, frame, origin, focal, 2 * half_size + 1, 2 * half_size + 1, depth_mm);
         const cv::Mat image = patch.Resample(grey, cv::INTER_CUBIC);
         const Eigen::Vector2d centre(half_size, half_size);
         for (Eigen::Vector2d& n : neighbours) n += centre;
         Eigen::Vector2d refined_patch;
-        moved = RefineInImage(target, image, centre, neighbours, by_edges, &refined_patch) && patch.ToOmni(refined_patch, &refined);
+        moved = RefineInImage(target, image, centre, neighbours, corner_by_edges, &refined_patch) && patch.ToOmni(refined_patch, &refined);
       }
     }
+    // A junction the edge profiles cannot read (the rim cuts its outer side, a square
+    // squashed to a few px): its squares fitted whole (calib/checker_junction_fit.h).
+    if (!moved && corner_by_edges && target.type() == CalibrationTarget::Type::kCheckerboard)
+      moved = FitCheckerJunction(target, grey, *guess, warp, corner.id, corner.pixel, detected_px, &refined);
     // A prediction stands only where the edges show a junction (a window method such as
     // cornerSubPix settles on anything with a gradient).
-    if (corner.predicted && !(moved && by_edges)) continue;
+    if (corner.predicted && !moved) continue;
     if (moved) {
       corner.pixel = refined;
       ++local.refined;
@@ -416,7 +435,10 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
   // pixels (calib/tag_template_fit.h) from where the edge profiles (or the detector) put
   // them. A fit whose residual is far above the image's typical one settled in another
   // minimum (the bits one column over): those tags keep the corners above, as do all of an
-  // image with under 3 fitted tags.
+  // image with under 3 fitted tags. A tag with predicted corners (cut by the rim:
+  // calib/checkerboard_completion.h) is fitted across the rim, and those of its corners
+  // the mirror shows are kept; a prediction without such a fit is dropped.
+  std::set<size_t> confirmed;  // predicted corners a tag's fit placed
   if (guess && fit_whole_tags && target.type() == CalibrationTarget::Type::kAprilGrid) {
     std::map<int, std::array<int, 4>> tags;  // tag id -> index in out.corners per k
     for (size_t i = 0; i < out.corners.size(); ++i) {
@@ -424,28 +446,49 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
       auto entry = tags.try_emplace(out.corners[i].id / 4, std::array<int, 4>{-1, -1, -1, -1}).first;
       entry->second[out.corners[i].id % 4] = static_cast<int>(i);
     }
-    std::vector<std::pair<std::array<int, 4>, TagTemplateFit>> fits;
+    struct Fitted {
+      std::array<int, 4> index;
+      TagTemplateFit fit;
+      bool across_rim;
+    };
+    std::vector<Fitted> fits;
     for (const auto& [tag, index] : tags) {
       if (std::count(index.begin(), index.end(), -1) > 0) continue;
       std::array<Eigen::Vector2d, 4> start;
-      for (int k = 0; k < 4; ++k) start[k] = out.corners[index[k]].pixel;
-      if (TagTemplateFit fit; FitTagTemplate(target, grey, *guess, tag, start, &fit)) fits.push_back({index, fit});
+      bool across_rim = false;
+      for (int k = 0; k < 4; ++k) start[k] = out.corners[index[k]].pixel, across_rim = across_rim || out.corners[index[k]].predicted;
+      // A found tag with a corner at the rim (which the plain fit keeps clear of) is fitted
+      // across it as well.
+      TagTemplateFit fit;
+      if (!across_rim && !FitTagTemplate(target, grey, *guess, warp, tag, start, &fit)) across_rim = true;
+      if (!across_rim || FitTagTemplate(target, grey, *guess, warp, tag, start, &fit, true)) fits.push_back({index, fit, across_rim});
     }
-    // The median needs a few fits to say what is typical: with fewer, none is trusted.
+    // The median needs a few fits to say what is typical (the complete tags'): with fewer,
+    // none is trusted.
     std::vector<double> relative;
-    for (const auto& [index, fit] : fits) relative.push_back(fit.rms_grey / fit.contrast);
+    for (const Fitted& f : fits)
+      if (!f.across_rim) relative.push_back(f.fit.rms_grey / f.fit.contrast);
     if (relative.size() >= 3) {
       std::nth_element(relative.begin(), relative.begin() + relative.size() / 2, relative.end());
       const double typical = relative[relative.size() / 2];
-      for (const auto& [index, fit] : fits) {
-        if (fit.rms_grey / fit.contrast > 2.5 * typical) continue;
+      for (const Fitted& f : fits) {
+        if (f.fit.rms_grey / f.fit.contrast > 2.5 * typical) continue;
         for (int k = 0; k < 4; ++k) {
-          CornerObservation& corner = out.corners[index[k]];
-          corner.pixel = fit.corners_px[k];
+          if (!f.fit.on_mirror[k]) continue;
+          CornerObservation& corner = out.corners[f.index[k]];
+          corner.pixel = f.fit.corners_px[k];
+          if (corner.predicted) confirmed.insert(f.index[k]), ++local.refined;
           if (corner.unrefined) corner.unrefined = false, --local.unrefined, ++local.refined;
         }
       }
     }
+  }
+  if (target.type() == CalibrationTarget::Type::kAprilGrid) {
+    ImageDetections kept = out;
+    kept.corners.clear();
+    for (size_t i = 0; i < out.corners.size(); ++i)
+      if (!out.corners[i].predicted || confirmed.count(i)) kept.corners.push_back(out.corners[i]);
+    out = kept;
   }
   if (stats) *stats = local;
   return out;

@@ -19,6 +19,11 @@
 // settled in another minimum and is not used. On the realistic aprilgrid renders through
 // the true sensor the edge profiles were 0.25 px (mid-field) and 0.32 px (at the rim) from
 // the truth, the tag fits 0.033 and 0.109 (TagTemplateFit.PutsTagCornersOnTheTruth...).
+// A tag with predicted corners (calib/checkerboard_completion.h), or found whole with a
+// corner at the rim, is fitted across the rim, and keeps the corners the mirror shows.
+// Through a guess, a checkerboard junction whose edges cannot be read (kEdges, or any
+// prediction) is fitted whole (calib/checker_junction_fit.h): at the rim, where the squares
+// beyond it are a sliver, 0.03-0.10 px from the truth on the realistic renders.
 //
 // Measured (tests/bench/detection_recall, docs/detection-recall.md): aprilgrid corners
 // 0.079-0.127 px RMS from virtual views -> 0.045-0.092 px refined in patches; raw
@@ -34,6 +39,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "calib/board_warp.h"
 #include "calib/detections.h"
 #include "calib/target.h"
 #include "model/sensor.h"
@@ -72,10 +78,11 @@ enum class CheckerRefinement { kSubPixel, kEdges };
 // except with kEdges through a guess.
 // fit_whole_tags: the aprilgrid tags fitted whole through the guess (above); off, the edge
 // profiles alone (a first pass whose corners only start a fit: a quarter of the time).
+// warp: the board's bend, which the pieces fitted whole follow (calib/printed_patch_fit.h).
 ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& grey, const Sensor* guess,
                               const ImageDetections& detections, CornerRefinementStats* stats = nullptr,
                               double min_checker_step_px = 0.0,
                               CheckerRefinement checker_refinement = CheckerRefinement::kSubPixel,
-                              bool fit_whole_tags = true);
+                              bool fit_whole_tags = true, const BoardWarp& warp = BoardWarp());
 
 }  // namespace omnical

@@ -1,28 +1,15 @@
 // An aprilgrid tag's four corners from every pixel around it: the printed pattern (black
-// square, data bits, white gap, as the target spec prints it), blurred, is fitted to the omni
-// image. Where the edge profiles of calib/refine_corners.h cannot settle a corner (near the
-// rim a tag is squashed to a few px radially, and the profiles across its edges scatter by
-// a tenth of a cell and more) the whole tag still holds hundreds of edge pixels.
-//
-// Model of a pixel p: paper + (ink - paper) x coverage(p), coverage the ink fraction of
-// the board around the point where p's ray (the sensor's own, non-central) meets the tag's
-// plane, under a Gaussian in the omni image (the optics' blur, sigma_px, and the pixel's
-// width) carried to the board: part of it by 3 x 3 quadrature nodes through the second-
-// order map pixel -> board (near the rim that map shears and bends over the blur's width;
-// one Gaussian per board axis put a noise-free rim render's corners 0.36 px off, the
-// quadrature 0.12), the rest as one Gaussian per board axis around each node, so the
-// ink's rectangles blur separably (erf products). Fitted (Ceres, automatic derivatives,
-// one Cauchy-weighted residual per pixel): the tag plane's pose (6), sigma_px, ink and
-// paper levels, over the pixels within one cell of the tag's black square (data bits and
-// gap included), from a pose by PnP on the given corners. The corners are the fitted
-// pose's, projected through the sensor; a sensor error moves them only by how much it
-// bends the image over one tag.
+// square, data bits, white gap, as the target spec prints it) fitted whole to the omni
+// image (calib/printed_patch_fit.h) over the pixels within one cell of the tag's black
+// square, from a pose by PnP on the given corners; the corners are the fitted pose's,
+// projected through the sensor.
 #pragma once
 
 #include <Eigen/Core>
 #include <array>
 #include <opencv2/core.hpp>
 
+#include "calib/board_warp.h"
 #include "calib/target.h"
 #include "model/sensor.h"
 
@@ -30,18 +17,28 @@ namespace omnical {
 
 struct TagTemplateFit {
   std::array<Eigen::Vector2d, 4> corners_px;  // corner ids 4 tag + k, k = 0..3 (calib/target.h)
+  // Across the rim: which corners lie on the mirror, a px and more inside its rim (the
+  // others' corners_px are where the mirror would show them were it wider).
+  std::array<bool, 4> on_mirror = {true, true, true, true};
   double blur_px = 0.0;                       // the fitted Gaussian's sigma, omni px
   double contrast = 0.0;                      // paper - ink, grey levels
   double rms_grey = 0.0;                      // the fit's residual RMS, grey levels
   int pixels = 0;                             // fitted pixels
 };
 
-// Fits the tag with id `tag` (its corners' ids 4 tag + k) of an aprilgrid (tag36h11: a black square of 8
-// cells with a white ring around, target.Reflectance) from `start_px`, its corners in the
-// omni image `grey` (8-bit). False when it cannot: too few pixels on the mirror, the fit
-// does not converge, no contrast, the pattern does not match (residual over a quarter of
-// the contrast), an implausible blur, or a corner moved more than half a cell.
-bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& sensor, int tag,
-                    const std::array<Eigen::Vector2d, 4>& start_px, TagTemplateFit* fit);
+// Fits the tag with id `tag` (its corners' ids 4 tag + k) of an aprilgrid (tag36h11: a
+// black square of 8 cells with a white ring around, target.Reflectance) on a board bent by
+// `warp`, from `start_px`, its corners in the omni image `grey` (8-bit). False when it
+// cannot: too few pixels on the mirror, the fit does not converge, no contrast, the pattern
+// does not match (residual over a quarter of the contrast), an implausible blur, or a
+// corner moved more than half a cell.
+// across_rim: a tag the mirror's rim cuts (calib/checkerboard_completion.h predicts it):
+// start_px may lie beyond the rim (where a wider mirror would show them), the rim is
+// modelled instead of kept clear of; a corner must lie within kRimClearancePx of the rim (a
+// pixel whose ray passes beyond it) and one on the mirror.
+// Elsewhere no corner may lie within kRimClearancePx of the rim.
+bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& sensor, const BoardWarp& warp,
+                    int tag, const std::array<Eigen::Vector2d, 4>& start_px, TagTemplateFit* fit,
+                    bool across_rim = false);
 
 }  // namespace omnical

@@ -17,6 +17,7 @@
 #include <set>
 
 #include "calib/checkerboard_candidates.h"
+#include "calib/checker_junction_fit.h"
 #include "calib/checkerboard_completion.h"
 #include "calib/detect.h"
 #include "calib/partial_checkerboard.h"
@@ -330,6 +331,12 @@ TEST(RefineCorners, BringsAprilGridCornersUnderATenthOfAPixel) {
   EXPECT_LT(std::sqrt(after / total), 0.8 * std::sqrt(before / total));
 }
 
+std::map<int, Eigen::Vector2d> PixelsById(const ImageDetections& view) {
+  std::map<int, Eigen::Vector2d> pixels;
+  for (const CornerObservation& c : view.corners) pixels[c.id] = c.pixel;
+  return pixels;
+}
+
 // The tag template fit (calib/tag_template_fit.h) on the realistic renders (blur 0.8 px,
 // noise, JPEG 85, colour, a 3 mm board warp), through the true sensor, from each complete
 // tag's true corners moved 0.5 px (k-dependent directions, so the start is a sheared,
@@ -346,13 +353,13 @@ TEST(TagTemplateFit, PutsTagCornersOnTheTruthMidFieldAndAtTheRim) {
   const DetectionSet truth = DetectionsFromGroundTruth({set + "/real004.json", set + "/rim1.json"});
   const CalibrationTarget target = CalibrationTarget::FromYaml(truth.target_spec);
   const double bound_px[2] = {0.07, 0.2};
+  const BoardWarp warp{3.0, -1.5};  // the render's (its json's warp_mm)
   for (size_t v = 0; v < truth.images.size(); ++v) {
     const ImageDetections& view = truth.images[v];
     SCOPED_TRACE(view.image);
     const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(grey.empty());
-    std::map<int, Eigen::Vector2d> expected;
-    for (const CornerObservation& c : view.corners) expected[c.id] = c.pixel;
+    std::map<int, Eigen::Vector2d> expected = PixelsById(view);
     double square_sum = 0.0;
     int tags = 0, fitted = 0;
     for (int tag = 0; tag < 36; ++tag) {
@@ -378,7 +385,7 @@ TEST(TagTemplateFit, PutsTagCornersOnTheTruthMidFieldAndAtTheRim) {
       if (by_the_rim) continue;
       ++tags;
       TagTemplateFit fit;
-      if (!FitTagTemplate(target, grey, sensor, tag, start, &fit)) continue;
+      if (!FitTagTemplate(target, grey, sensor, warp, tag, start, &fit)) continue;
       ++fitted;
       for (int k = 0; k < 4; ++k) square_sum += (fit.corners_px[k] - expected[4 * tag + k]).squaredNorm();
       EXPECT_NEAR(fit.blur_px, 0.8, 0.2) << "tag " << tag;  // the render's blur
@@ -397,7 +404,77 @@ TEST(TagTemplateFit, PutsTagCornersOnTheTruthMidFieldAndAtTheRim) {
       if (c.id == k) start[k] = c.pixel;
   const cv::Mat paper(sensor.image_height_px(), sensor.image_width_px(), CV_8UC1, cv::Scalar(200));
   TagTemplateFit fit;
-  EXPECT_FALSE(FitTagTemplate(target, paper, sensor, 0, start, &fit));
+  EXPECT_FALSE(FitTagTemplate(target, paper, sensor, warp, 0, start, &fit));
+}
+
+// The checkerboard junction fit (calib/checker_junction_fit.h) on the realistic renders,
+// through the true sensor and the board's true warp, each junction from its true position
+// moved 0.5 px, the image's other corners at their truth: (1) the rim junctions whose outer
+// squares the rim cuts to a sliver, which the edge profiles cannot read (rim0 36-39,
+// real007 45-47, left out of the corners found, as the detector leaves them); (2) every
+// junction of a mid-field board (real003). Measured: rim0 0.066 px RMS from the truth,
+// real007 0.100 (worst 0.103); mid-field 0.009 px (with the board taken flat: 0.047, and at
+// the rim 0.040 / 0.120). Bounds: 0.15 px RMS and 0.2 px worst at the rim (a start or a
+// platform's rounding may settle a junction differently; in calibrate, through the first
+// fit, 0.03-0.10 px), 0.03 px mid-field; every junction fitted. Plain paper where the board
+// was is refused.
+TEST(CheckerJunctionFit, PutsRimJunctionsTheRimCutsOnTheTruth) {
+  const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/realistic-checkerboard";
+  const Sensor sensor = LoadSensorYaml(set + "/sensor.yaml");
+  const DetectionSet truth = DetectionsFromGroundTruth({set + "/rim0.json", set + "/real007.json", set + "/real003.json"});
+  const CalibrationTarget target = CalibrationTarget::FromYaml(truth.target_spec);
+  const std::vector<std::vector<int>> rim_junctions = {{36, 37, 38, 39}, {45, 46, 47}, {}};
+  const BoardWarp warp{3.0, 1.0};  // the render's (its json's warp_mm)
+  for (size_t v = 0; v < truth.images.size(); ++v) {
+    const ImageDetections& view = truth.images[v];
+    SCOPED_TRACE(view.image);
+    const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(grey.empty());
+    std::map<int, Eigen::Vector2d> expected = PixelsById(view);
+    std::vector<int> junctions = rim_junctions[v];
+    std::map<int, Eigen::Vector2d> found = expected;
+    if (junctions.empty())
+      for (const auto& [id, pixel] : expected) junctions.push_back(id);
+    else
+      for (int id : junctions) found.erase(id);
+    ASSERT_GE(junctions.size(), 3u);
+    double square_sum = 0.0, worst = 0.0;
+    int fitted = 0;
+    for (int id : junctions) {
+      ASSERT_TRUE(expected.count(id)) << id;
+      const double angle = 0.7 * id;
+      const Eigen::Vector2d start = expected[id] + 0.5 * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+      std::map<int, Eigen::Vector2d> others = found;
+      others.erase(id);
+      Eigen::Vector2d junction;
+      if (!FitCheckerJunction(target, grey, sensor, warp, id, start, others, &junction)) {
+        ADD_FAILURE() << "junction " << id << " not fitted";
+        continue;
+      }
+      ++fitted;
+      const double error = (junction - expected[id]).norm();
+      square_sum += error * error;
+      worst = std::max(worst, error);
+    }
+    const double rms = std::sqrt(square_sum / std::max(1, fitted));
+    std::printf("%s: %d of %zu junctions fitted, %.3f px RMS from the truth, worst %.3f\n", view.image.c_str(), fitted,
+                junctions.size(), rms, worst);
+    if (rim_junctions[v].empty()) {
+      EXPECT_LT(rms, 0.03);
+    } else {
+      EXPECT_LT(rms, 0.15);
+      EXPECT_LT(worst, 0.2);
+    }
+  }
+  // Plain paper where the board was: no contrast, refused.
+  const ImageDetections& view = truth.images[2];
+  std::map<int, Eigen::Vector2d> found = PixelsById(view);
+  const cv::Mat paper(sensor.image_height_px(), sensor.image_width_px(), CV_8UC1, cv::Scalar(200));
+  const int id = found.begin()->first;
+  const Eigen::Vector2d start = found.begin()->second;
+  found.erase(id);
+  Eigen::Vector2d junction;
+  EXPECT_FALSE(FitCheckerJunction(target, paper, sensor, BoardWarp(), id, start, found, &junction));
 }
 
 // Checkerboard X-junctions: cornerSubPix with a window of 0.4 square, on the omni image
@@ -1091,6 +1168,62 @@ TEST(CheckerboardCompletion, PredictsTheMissingCornersThroughTheFit) {
             fitted.images[0].corners.size());
   fit.poses.pop_back();
   EXPECT_THROW(WithPredictedCheckerCorners(target, sensor, fit.board_warp->warp, fitted, fit, fitted), std::logic_error);
+}
+
+// The same for an aprilgrid's tags (WithPredictedTagCorners): on the realistic aprilgrid
+// scene's rim0 view (its outer row of tags cut by the rim) with the true sensor, pose and
+// warp as the "fit", and the tags the rim cuts (24-31) and one corner of a mid tag left out
+// of what was found: every missing corner of a tag with a corner on the mirror is predicted,
+// on its exact pixel where the truth sees it (1e-6 px) and beyond the rim where it does
+// not (the wider mirror's view); a tag wholly found gets none; a checkerboard gets none.
+TEST(CheckerboardCompletion, PredictsTheTagsTheRimCutsThroughTheFit) {
+  const Scene scene = LoadSceneYaml(testing::SourceDir() + "/datasets-synthetic/scenes/realistic-aprilgrid.yaml");
+  const Sensor& sensor = *scene.sensor;
+  const SceneView& view = scene.views[0];
+  ASSERT_EQ(view.name.substr(view.name.size() - 4), "rim0") << view.name;
+  const CalibrationTarget& target = *view.targets[0].target;
+  FitResult fit;
+  fit.board_warp = BoardWarpEstimate{view.targets[0].surface.warp};
+  const PlacedTarget& placed = view.targets[0];
+  fit.poses.push_back({Eigen::Quaterniond(placed.camera_from_target_rotation), placed.camera_from_target_translation_mm});
+  fit.view_left_out.push_back("");
+  DetectionSet fitted;
+  ImageDetections image;
+  image.image = view.name;
+  std::map<int, CornerTruth> truth;
+  const std::vector<TargetTruth> view_truth = GroundTruth(sensor, view);
+  for (const CornerTruth& c : view_truth[0].corners) truth[c.id] = c;
+  auto left_out = [](int id) { return (id / 4 >= 24 && id / 4 <= 31) || id == 4 * 14 + 2; };
+  for (const auto& [id, c] : truth)
+    if (c.visible && !left_out(id)) image.corners.push_back({id, c.pixel});
+  fitted.images.push_back(image);
+  const DetectionSet completed = WithPredictedTagCorners(target, sensor, fit.board_warp->warp, fitted, fit, fitted);
+  ASSERT_EQ(completed.images.size(), 1u);
+  std::set<int> predicted;
+  int beyond_rim = 0;
+  for (const CornerObservation& c : completed.images[0].corners) {
+    if (!c.predicted) continue;
+    predicted.insert(c.id);
+    EXPECT_TRUE(left_out(c.id)) << "corner " << c.id;
+    if (truth.at(c.id).visible) {
+      EXPECT_LT((c.pixel - truth.at(c.id).pixel).norm(), 1e-6) << "corner " << c.id;
+    } else {
+      Eigen::Vector3d origin, direction;
+      EXPECT_NE(sensor.Unproject(c.pixel, &origin, &direction), ProjectionStatus::kOk) << "corner " << c.id;
+      ++beyond_rim;
+    }
+  }
+  for (int id = 0; id < 4 * 36; ++id) {
+    if (!left_out(id)) continue;
+    bool tag_on_mirror = false;
+    for (int k = 0; k < 4; ++k) tag_on_mirror = tag_on_mirror || truth.at(4 * (id / 4) + k).visible;
+    EXPECT_EQ(predicted.count(id) == 1, tag_on_mirror) << "corner " << id;
+  }
+  EXPECT_GE(beyond_rim, 8);  // the cut row's outer corners
+  const CalibrationTarget checkerboard =
+      CalibrationTarget::FromYaml(testing::SourceDir() + "/datasets-synthetic/targets/checkerboard-8x6-30mm.yaml");
+  EXPECT_EQ(WithPredictedTagCorners(checkerboard, sensor, BoardWarp(), fitted, fit, fitted).images[0].corners.size(),
+            fitted.images[0].corners.size());
 }
 
 }  // namespace
