@@ -1,5 +1,6 @@
 #include "calib/checker_junction_fit.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -10,15 +11,23 @@
 
 namespace omnical {
 
+namespace {
+
+// A junction is kept this far inside the rim and more: its squares' fit holds the rim's
+// position (the realistic renders' rim junctions lie 1-3 px inside it, each visible).
+constexpr int kJunctionRimMarginPx = 0;
+
+}  // namespace
+
 bool FitCheckerJunction(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& sensor, const BoardWarp& warp,
                         int id, const Eigen::Vector2d& start_px, const std::map<int, Eigen::Vector2d>& found_px,
                         Eigen::Vector2d* junction_px) {
   if (target.type() != CalibrationTarget::Type::kCheckerboard) return false;
-  const int cols = target.cols(), row = id / cols, col = id % cols;
-  if (id < 0 || row >= target.rows()) return false;
+  const int cols = target.cols();
+  if (cols < 2 || target.rows() < 2 || id < 0 || id / cols >= target.rows()) return false;
+  const int row = id / cols, col = id % cols;
   std::map<int, Eigen::Vector3d> board_mm;
   for (const TargetCorner& c : target.corners()) board_mm[c.id] = c.point_in_target;
-  if (cols < 2 || target.rows() < 2) return false;
   const Eigen::Vector2d square_mm((board_mm.at(1) - board_mm.at(0)).norm(), (board_mm.at(cols) - board_mm.at(0)).norm());
 
   // The start pose from the corners up to two squares around (this one included): where
@@ -40,8 +49,21 @@ bool FitCheckerJunction(const CalibrationTarget& target, const cv::Mat& grey, co
   if (!(step_px >= 4.0 && step_px <= 400.0)) return false;
   // Too few of them, or on a line (a row along the rim): the pose of all the image's corners
   // starts it instead (flat, the board's warp aside: close enough for the fit).
+  // On a line: the least spread of their board points, across it, under a quarter square
+  // (IPPE may still return a pose, a poor one).
+  Eigen::Vector2d mean_mm = Eigen::Vector2d::Zero();
+  for (const CornerObservation& c : around.corners) mean_mm += board_mm.at(c.id).head<2>();
+  mean_mm /= static_cast<double>(around.corners.size());
+  Eigen::Matrix2d scatter_mm2 = Eigen::Matrix2d::Zero();
+  for (const CornerObservation& c : around.corners) {
+    const Eigen::Vector2d d = board_mm.at(c.id).head<2>() - mean_mm;
+    scatter_mm2 += d * d.transpose() / static_cast<double>(around.corners.size());
+  }
+  const bool on_a_line =
+      !(std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(scatter_mm2).eigenvalues()(0))) >=
+        0.25 * square_mm.minCoeff());
   TargetPose start_pose;
-  if (around.corners.size() < 4 || !InitialTargetPose(sensor, target, around, &start_pose)) {
+  if (around.corners.size() < 4 || on_a_line || !InitialTargetPose(sensor, target, around, &start_pose)) {
     ImageDetections all;
     for (const auto& [corner_id, pixel] : found_px) all.corners.push_back({corner_id, pixel});
     if (!InitialTargetPose(sensor, target, all, &start_pose)) return false;
@@ -61,6 +83,8 @@ bool FitCheckerJunction(const CalibrationTarget& target, const cv::Mat& grey, co
   region.image_high_px = start_px + half_box_px;
   region.on_mirror_px = {start_px};
   region.model_rim = true;
+  region.core_low_mm = at_mm - 0.5 * square_mm;  // the junction's own half squares
+  region.core_high_mm = at_mm + 0.5 * square_mm;
   // Twice: the pixels are chosen at the start pose, and a start from the whole image's pose
   // can be a square's fraction off.
   PatchFit patch;
@@ -71,7 +95,7 @@ bool FitCheckerJunction(const CalibrationTarget& target, const cv::Mat& grey, co
   const Eigen::Vector3d in_camera = patch.pose.camera_from_target_rotation * on_board_mm +
                                     patch.pose.camera_from_target_translation_mm;
   Eigen::Vector2d fitted_px;
-  if (sensor.Project(in_camera, &fitted_px) != ProjectionStatus::kOk) return false;
+  if (sensor.Project(in_camera, &fitted_px) != ProjectionStatus::kOk || !OnMirrorWithMargin(sensor, fitted_px, kJunctionRimMarginPx)) return false;
   if (!((fitted_px - start_px).norm() <= 0.25 * step_px)) return false;
   *junction_px = fitted_px;
   return true;

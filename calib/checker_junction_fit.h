@@ -16,11 +16,13 @@
 
 namespace omnical {
 
-// Junction `id` of a checkerboard bent by `warp` from `start_px` (a detection or a prediction) in the omni
-// image `grey` (8-bit), with `found_px` the image's other corners (id -> px; those within one
-// square on the board start the pose, 3 and more needed). False when it cannot: too few
-// corners around, the junction's pixel off the mirror, the fit refused
-// (calib/printed_patch_fit.h), or the junction moved over a quarter square.
+// Junction `id` of a checkerboard bent by `warp` from `start_px` (a detection or a
+// prediction) in the omni image `grey` (8-bit), with `found_px` the image's other corners
+// (id -> px; those within two squares on the board start the pose, all of them where those
+// are under 4 or on a line). False when it cannot: no corner found around it, the junction
+// off the mirror, the fit refused
+// (calib/printed_patch_fit.h: over the squares or the junction's own half squares), or the
+// junction moved over a quarter square.
 bool FitCheckerJunction(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& sensor, const BoardWarp& warp,
                         int id, const Eigen::Vector2d& start_px, const std::map<int, Eigen::Vector2d>& found_px,
                         Eigen::Vector2d* junction_px);

@@ -46,6 +46,9 @@ constexpr int kNumParams = 9;
 constexpr int kNumRimParams = 2;
 // With the rim modelled, pixels up to this far beyond it are fitted: the blur's reach.
 constexpr double kBeyondRimPx = 4.0;
+constexpr double kMaxRimShiftPx = 3.0;
+// Fitted pixels a region's core needs to be judged (and the piece kept).
+constexpr int kMinCorePixels = 20;
 
 class PatchResidual {
  public:
@@ -166,6 +169,15 @@ class PatchResidual {
 };
 
 }  // namespace
+
+bool OnMirrorWithMargin(const Sensor& sensor, const Eigen::Vector2d& pixel, int margin_px) {
+  for (int dv = -margin_px; dv <= margin_px; ++dv)
+    for (int du = -margin_px; du <= margin_px; ++du) {
+      Eigen::Vector3d origin, direction;
+      if (sensor.Unproject(pixel + Eigen::Vector2d(du, dv), &origin, &direction) != ProjectionStatus::kOk) return false;
+    }
+  return true;
+}
 
 bool FitPrintedPatch(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& sensor, const BoardWarp& warp,
                      const TargetPose& start, const PatchRegion& region, PatchFit* fit) {
@@ -326,7 +338,7 @@ bool FitPrintedPatch(const CalibrationTarget& target, const cv::Mat& grey, const
   parameters[6] = std::log(0.8);
   parameters[7] = sorted[sorted.size() / 10];
   parameters[8] = sorted[sorted.size() * 9 / 10];
-  double rim[kNumRimParams] = {0.0, parameters[7]};
+  double rim[kNumRimParams] = {0.0, parameters[7]};  // shift bounded below
   if (!beyond.empty()) {
     std::nth_element(beyond.begin(), beyond.begin() + beyond.size() / 2, beyond.end());
     rim[1] = beyond[beyond.size() / 2];
@@ -345,7 +357,14 @@ bool FitPrintedPatch(const CalibrationTarget& target, const cv::Mat& grey, const
         &loss, parameters, rim);
   // The rim's parameters held where no fitted pixel is within the blur's reach of it.
   const double nearest_rim_px = pixels.inside_rim_px.empty() ? HUGE_VAL : *std::min_element(pixels.inside_rim_px.begin(), pixels.inside_rim_px.end());
-  if (!region.model_rim || !(nearest_rim_px < 8.0)) problem.SetParameterBlockConstant(rim);
+  if (!region.model_rim || !(nearest_rim_px < 8.0)) {
+    problem.SetParameterBlockConstant(rim);
+  } else {
+    // A sensor's rim within a few px of the image's: farther, the shift would take over
+    // the piece's own edge.
+    problem.SetParameterLowerBound(rim, 0, -kMaxRimShiftPx);
+    problem.SetParameterUpperBound(rim, 0, kMaxRimShiftPx);
+  }
   ceres::Solver::Options options;
   options.max_num_iterations = 50;
   options.num_threads = 1;
@@ -362,11 +381,22 @@ bool FitPrintedPatch(const CalibrationTarget& target, const cv::Mat& grey, const
   ceres::Problem::EvaluateOptions plain;
   plain.apply_loss_function = false;
   double plain_cost = 0.0;
-  if (!problem.Evaluate(plain, &plain_cost, nullptr, nullptr, nullptr)) return false;
+  std::vector<double> residuals;  // per fitted pixel, in their order
+  if (!problem.Evaluate(plain, &plain_cost, &residuals, nullptr, nullptr)) return false;
   result.rms_grey = std::sqrt(2.0 * plain_cost / pixels.grey.size());
   if (!(result.contrast >= 20.0) || !(result.blur_px >= 0.1 && result.blur_px <= 4.0) ||
       !(result.rms_grey <= 0.25 * result.contrast))
     return false;
+  // The core must match on its own: a finger over it is a small share of the whole piece.
+  if (region.core_high_mm.x() > region.core_low_mm.x()) {
+    double core_sum = 0.0;
+    int core_pixels = 0;
+    for (size_t i = 0; i < residuals.size(); ++i)
+      if ((start_board[i].array() >= region.core_low_mm.array()).all() &&
+          (start_board[i].array() <= region.core_high_mm.array()).all())
+        core_sum += residuals[i] * residuals[i], ++core_pixels;
+    if (core_pixels < kMinCorePixels || !(std::sqrt(core_sum / core_pixels) <= 0.25 * result.contrast)) return false;
+  }
   const Eigen::Vector3d fitted_rotation_vector(parameters[0], parameters[1], parameters[2]);
   const double angle = fitted_rotation_vector.norm();
   result.pose.camera_from_target_rotation =

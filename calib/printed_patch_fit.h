@@ -47,11 +47,20 @@ struct PatchRegion {
   // amount (omni px; the sensor's rim may sit a px off the image's). For pieces the rim
   // cuts, whose edges run into it.
   bool model_rim = false;
+  // Where the fitted points lie (target mm; none when high <= low): the fitted pixels there
+  // (20 and more) must match on their own, residual RMS within a quarter of the contrast
+  // (a finger over a junction is a small share of the squares around it).
+  Eigen::Vector2d core_low_mm = Eigen::Vector2d::Zero(), core_high_mm = Eigen::Vector2d::Zero();
 };
 
 // Pixels within this distance of one whose ray misses the mirror (the rim, the camera
 // body's reflection) mix the board with the dark beyond in their blur and box: not fitted.
 constexpr int kRimClearancePx = 3;
+
+// Whether every pixel within margin_px of `pixel` (a square) is on the mirror. A fitted
+// point near the rim is kept only that far inside it: nearer, the rim's blur and a px of
+// the sensor's rim error make it moot.
+bool OnMirrorWithMargin(const Sensor& sensor, const Eigen::Vector2d& pixel, int margin_px);
 
 struct PatchFit {
   TargetPose pose;         // the fitted plane's camera_from_target
@@ -63,10 +72,10 @@ struct PatchFit {
 
 // Fits the target's ink, on the board bent by `warp` (calib/board_warp.h), over `region` of
 // the omni image `grey` (8-bit) from `start` (the board's pose: only its plane near the
-// region matters). False
-// when it cannot: too few pixels on the mirror (60), the fit not usable, no contrast (20
-// grey levels), an implausible blur (0.1-4 px), or a residual over a quarter of the
-// contrast (the pattern does not match).
+// region matters). False when it cannot: too few pixels on the mirror (60; 30 two px and
+// more inside the rim), the fit not usable, no contrast (20 grey levels), an implausible
+// blur (0.1-4 px), or a residual over a quarter of the contrast (the pattern does not
+// match), over the whole region or over its core.
 bool FitPrintedPatch(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& sensor, const BoardWarp& warp,
                      const TargetPose& start, const PatchRegion& region, PatchFit* fit);
 

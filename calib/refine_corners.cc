@@ -351,7 +351,7 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
     if (target.type() == CalibrationTarget::Type::kCheckerboard && min_checker_step_px > 0.0 && !corner_by_edges) {
       double omni_step_px = HUGE_VAL;
       for (int n : neighbour_ids)
-        if (by_id.count(n)) omni_step_px = std::min(omni_step_px, (by_id[n] - corner.pixel).norm());
+        if (detected_px.count(n)) omni_step_px = std::min(omni_step_px, (detected_px[n] - corner.pixel).norm());
       small_square = !(omni_step_px >= min_checker_step_px);
     }
     if (small_square) {
@@ -419,7 +419,7 @@ ImageDetections RefineCorners(const CalibrationTarget& target, const cv::Mat& gr
       moved = FitCheckerJunction(target, grey, *guess, warp, corner.id, corner.pixel, detected_px, &refined);
     // A prediction stands only where the edges show a junction (a window method such as
     // cornerSubPix settles on anything with a gradient).
-    if (corner.predicted && !moved) continue;
+    if (corner.predicted && !(moved && corner_by_edges)) continue;
     if (moved) {
       corner.pixel = refined;
       ++local.refined;

@@ -63,10 +63,13 @@ bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const 
   const double margin_px = (across_rim ? 1.3 : 0.25) * edge_px + 4.0 + kRimClearancePx;
   region.image_low_px = box_low - Eigen::Vector2d::Constant(margin_px);
   region.image_high_px = box_high + Eigen::Vector2d::Constant(margin_px);
-  if (across_rim)
+  if (across_rim) {
     region.model_rim = true;
-  else
+    region.core_low_mm = board_corners[0];  // the tag's own square: the neighbours must not stand in for it
+    region.core_high_mm = board_corners[2];
+  } else {
     region.clear_px.assign(start_px.begin(), start_px.end());
+  }
   PatchFit patch;
   if (!FitPrintedPatch(target, grey, sensor, warp, start_pose, region, &patch)) return false;
 
@@ -89,15 +92,7 @@ bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const 
         patch.pose.camera_from_target_translation_mm;
     if (wide.Project(corner_in_camera, &result.corners_px[k]) != ProjectionStatus::kOk) return false;
     if (!((result.corners_px[k] - start_px[k]).norm() <= 0.5 * std::max(cell_px, 1.0))) return false;
-    // On the mirror: the pixels around it too (the rim's blur makes a corner right on it
-    // moot).
-    result.on_mirror[k] = true;
-    for (int dv = -2; dv <= 2; ++dv)
-      for (int du = -2; du <= 2; ++du) {
-        Eigen::Vector3d origin, direction;
-        if (sensor.Unproject(result.corners_px[k] + Eigen::Vector2d(du, dv), &origin, &direction) != ProjectionStatus::kOk)
-          result.on_mirror[k] = false;
-      }
+    result.on_mirror[k] = OnMirrorWithMargin(sensor, result.corners_px[k], kCornerRimMarginPx);
     if (!across_rim && !result.on_mirror[k]) return false;
   }
   if (std::count(result.on_mirror.begin(), result.on_mirror.end(), true) == 0) return false;

@@ -416,8 +416,8 @@ TEST(TagTemplateFit, PutsTagCornersOnTheTruthMidFieldAndAtTheRim) {
 // real007 0.100 (worst 0.103); mid-field 0.009 px (with the board taken flat: 0.047, and at
 // the rim 0.040 / 0.120). Bounds: 0.15 px RMS and 0.2 px worst at the rim (a start or a
 // platform's rounding may settle a junction differently; in calibrate, through the first
-// fit, 0.03-0.10 px), 0.03 px mid-field; every junction fitted. Plain paper where the board
-// was is refused.
+// fit, 0.03-0.10 px), 0.03 px mid-field; every junction fitted. A finger over a junction
+// and plain paper where the board was are refused.
 TEST(CheckerJunctionFit, PutsRimJunctionsTheRimCutsOnTheTruth) {
   const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/realistic-checkerboard";
   const Sensor sensor = LoadSensorYaml(set + "/sensor.yaml");
@@ -466,9 +466,26 @@ TEST(CheckerJunctionFit, PutsRimJunctionsTheRimCutsOnTheTruth) {
       EXPECT_LT(worst, 0.2);
     }
   }
-  // Plain paper where the board was: no contrast, refused.
+  // A finger over a mid-field junction (a disc of skin grey, 0.3 of a square in radius):
+  // the squares around still fit and would place it (0.008 px from the truth, through the
+  // grid's lines: a prediction, not a detection), but its own half squares do not match:
+  // refused.
   const ImageDetections& view = truth.images[2];
   std::map<int, Eigen::Vector2d> found = PixelsById(view);
+  {
+    const int covered = 3 * target.cols() + 3;
+    ASSERT_TRUE(found.count(covered) && found.count(covered + 1));
+    cv::Mat fingered = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+    const double square_px = (found[covered + 1] - found[covered]).norm();
+    cv::circle(fingered, cv::Point(static_cast<int>(std::lround(found[covered].x())), static_cast<int>(std::lround(found[covered].y()))),
+               static_cast<int>(std::lround(0.3 * square_px)), cv::Scalar(150), cv::FILLED);
+    std::map<int, Eigen::Vector2d> others = found;
+    others.erase(covered);
+    Eigen::Vector2d junction;
+    EXPECT_FALSE(FitCheckerJunction(target, fingered, sensor, warp, covered, found[covered], others, &junction))
+        << "fitted at " << (junction - found[covered]).norm() << " px from the truth";
+  }
+  // Plain paper where the board was: no contrast, refused.
   const cv::Mat paper(sensor.image_height_px(), sensor.image_width_px(), CV_8UC1, cv::Scalar(200));
   const int id = found.begin()->first;
   const Eigen::Vector2d start = found.begin()->second;

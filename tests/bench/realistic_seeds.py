@@ -16,7 +16,7 @@ the std are honest), how many seeds have a parameter beyond 3 std and the worst,
 visible corners found and used by the fit (found, refined where asked, not cut).
 
 Usage: tests/bench/realistic_seeds.py --omnical build/test/tools/omnical [--seeds 6]
-       [--kinds checkerboard,aprilgrid] [--out docs/realistic-seeds.md]
+       [--kinds checkerboard,aprilgrid] [--option-sets '(default);--view-weights'] [--out docs/realistic-seeds.md]
 ~1 min per seed and option set on 2 cores (render ~20 s per seed, each calibration ~20 s).
 """
 import argparse
@@ -74,6 +74,8 @@ def main():
     parser.add_argument("--seeds", type=int, default=6)
     parser.add_argument("--kinds", default="checkerboard,aprilgrid")
     parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--option-sets", default="",
+                        help="only these option sets, ';'-separated as the report names them, e.g. '(default);--view-weights'")
     parser.add_argument("--out", default=os.path.join(source_dir, "docs", "realistic-seeds.md"))
     args = parser.parse_args()
     started = time.time()
@@ -89,6 +91,8 @@ def main():
                 seeded_scene(kind, k, scene)
                 run([args.omnical, "-q", "render", "--scene", scene, "--out", render_dir, "--threads", str(args.threads)])
                 for options in option_sets[kind]:
+                    if args.option_sets and (" ".join(options) or "(default)") not in args.option_sets.split(";"):
+                        continue
                     cal_dir = os.path.join(work, "cal-%s-%d-%s" % (kind, k, "".join(options) or "default"))
                     run([args.omnical, "-q", "calibrate", "--target", target, "--images", render_dir, "--sensor", guess,
                          "--board-warp", "--threads", str(args.threads)] + options + ["--out", cal_dir])
