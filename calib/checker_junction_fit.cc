@@ -47,10 +47,9 @@ bool FitCheckerJunction(const CalibrationTarget& target, const cv::Mat& grey, co
       step_px = std::max(step_px, (it->second - start_px).norm() / std::hypot(dr, dc));
     }
   if (!(step_px >= 4.0 && step_px <= 400.0)) return false;
-  // Too few of them, or on a line (a row along the rim): the pose of all the image's corners
-  // starts it instead (flat, the board's warp aside: close enough for the fit).
-  // On a line: the least spread of their board points, across it, under a quarter square
-  // (IPPE may still return a pose, a poor one).
+  // Too few of them, or on a line (a row along the rim: their board points' least spread
+  // under a quarter square, where IPPE may still return a poor pose): the pose of all the
+  // image's corners starts it instead (flat, the board's warp aside: close enough).
   Eigen::Vector2d mean_mm = Eigen::Vector2d::Zero();
   for (const CornerObservation& c : around.corners) mean_mm += board_mm.at(c.id).head<2>();
   mean_mm /= static_cast<double>(around.corners.size());
