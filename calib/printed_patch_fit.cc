@@ -65,7 +65,6 @@ class PatchResidual {
     // board_from_camera: the transpose of the pose's rotation.
     T rotation[9];  // row-major camera_from_board
     ceres::AngleAxisToRotationMatrix(p, ceres::RowMajorAdapter3x3(rotation));
-    const Eigen::Matrix<T, 3, 1> normal(rotation[2], rotation[5], rotation[8]);
     const Eigen::Matrix<T, 3, 1> centre(p[3], p[4], p[5]);
     // Where a ray meets the board, in board mm (x, y): its plane, then two Newton steps onto
     // the warped surface (a sag of mm over a board of hundreds: the second step moves it by
