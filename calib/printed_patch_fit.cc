@@ -50,55 +50,156 @@ constexpr double kMaxRimShiftPx = 3.0;
 // Fitted pixels a region's core needs to be judged (and the piece kept).
 constexpr int kMinCorePixels = 20;
 
+// Where a ray (origin o, direction d, camera frame) meets the board at pose
+// camera_from_board (row-major rotation, centre mm), in board mm (x, y): its plane, then two
+// Newton steps onto the warped surface (a sag of mm over a board of hundreds: the second
+// step moves it by well under a micrometre). False when the ray runs along the plane or
+// meets it behind its origin (Ceres then refuses the step).
+template <typename T>
+bool RayOnBoard(const T* rotation, const T* centre, const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                const WarpedSurface& surface, T* x, T* y) {
+  const bool warped = !surface.warp.IsZero();
+  const Eigen::Vector2d mid_mm = 0.5 * (surface.low_mm + surface.high_mm);
+  const Eigen::Vector2d half_mm = (0.5 * (surface.high_mm - surface.low_mm)).cwiseMax(1e-9);
+  // The ray in the board frame: a + t b.
+  const T ox = T(o.x()) - centre[0], oy = T(o.y()) - centre[1], oz = T(o.z()) - centre[2];
+  T a[3], b[3];
+  for (int k = 0; k < 3; ++k) {
+    a[k] = rotation[k] * ox + rotation[3 + k] * oy + rotation[6 + k] * oz;
+    b[k] = rotation[k] * d.x() + rotation[3 + k] * d.y() + rotation[6 + k] * d.z();
+  }
+  if (!(std::abs(ScalarPart(b[2])) > 1e-9)) return false;
+  T t = -a[2] / b[2];
+  for (int step = 0; warped && step < 2; ++step) {
+    const T u = (a[0] + t * b[0] - T(mid_mm.x())) / T(half_mm.x()), v = (a[1] + t * b[1] - T(mid_mm.y())) / T(half_mm.y());
+    const T sag = T(surface.warp.x_mm) * (T(1.0) - u * u) + T(surface.warp.y_mm) * (T(1.0) - v * v);
+    const T slope_x = T(-2.0 * surface.warp.x_mm / half_mm.x()) * u, slope_y = T(-2.0 * surface.warp.y_mm / half_mm.y()) * v;
+    const T along = b[2] - slope_x * b[0] - slope_y * b[1];
+    if (!(std::abs(ScalarPart(along)) > 1e-9)) return false;
+    t -= (a[2] + t * b[2] - sag) / along;
+  }
+  if (!(ScalarPart(t) > 0.0)) return false;
+  *x = a[0] + t * b[0];
+  *y = a[1] + t * b[1];
+  return true;
+}
+
+// A value whose derivatives by the pose p[0..5] are `gradient`, as a T: the chain rule
+// through p's own derivatives (a Jet), or the value (a double).
+inline double WithPoseGradient(double value, const double* /*gradient*/, const double* /*p*/) { return value; }
+template <int N>
+ceres::Jet<double, N> WithPoseGradient(double value, const double* gradient, const ceres::Jet<double, N>* p) {
+  ceres::Jet<double, N> out(value);
+  for (int k = 0; k < 6; ++k) out.v += gradient[k] * p[k].v;
+  return out;
+}
+
+// The fitted pixels' rays on the board at Ceres' evaluation point, with their derivatives
+// by the pose, once per evaluation: each ray serves the residuals of up to 9 pixels (the
+// 3 x 3 around each), intersected in every one of them, in Jets of all 11 parameters.
+class RaysOnBoard : public ceres::EvaluationCallback {
+ public:
+  // `pose`: the problem's parameter block (its first 6 values are the pose).
+  RaysOnBoard(const FitPixels& pixels, const WarpedSurface& surface, const double* pose)
+      : pixels_(pixels), surface_(surface), pose_(pose), points_(pixels.origins.size()) {
+    std::vector<char> used(pixels.origins.size(), 0);
+    for (const std::array<int, 9>& around : pixels.rays)
+      for (int ray : around) used[ray] = 1;
+    for (size_t ray = 0; ray < used.size(); ++ray)
+      if (used[ray]) used_.push_back(static_cast<int>(ray));
+  }
+
+  void PrepareForEvaluation(bool /*evaluate_jacobians*/, bool new_evaluation_point) override {
+    if (valid_ && !new_evaluation_point) return;
+    using Jet6 = ceres::Jet<double, 6>;
+    Jet6 p[6];
+    for (int k = 0; k < 6; ++k) p[k] = Jet6(pose_[k], k), at_pose_[k] = pose_[k];
+    Jet6 rotation[9];  // row-major camera_from_board
+    ceres::AngleAxisToRotationMatrix(p, ceres::RowMajorAdapter3x3(rotation));
+    for (int ray : used_) {
+      Point& point = points_[ray];
+      Jet6 x, y;
+      point.ok = RayOnBoard(rotation, p + 3, pixels_.origins[ray], pixels_.directions[ray], surface_, &x, &y);
+      if (!point.ok) continue;
+      point.x = x.a, point.y = y.a;
+      for (int k = 0; k < 6; ++k) point.dx[k] = x.v[k], point.dy[k] = y.v[k];
+    }
+    valid_ = true;
+  }
+
+  // Ray `ray` on the board at pose p[0..5]; false where it misses the board. Computed
+  // afresh should p not be the point prepared (Ceres promises it is).
+  template <typename T>
+  bool At(int ray, const T* p, T* x, T* y) const {
+    bool prepared = valid_;
+    for (int k = 0; k < 6 && prepared; ++k) prepared = ScalarPart(p[k]) == at_pose_[k];
+    if (!prepared) {
+      T rotation[9];
+      ceres::AngleAxisToRotationMatrix(p, ceres::RowMajorAdapter3x3(rotation));
+      return RayOnBoard(rotation, p + 3, pixels_.origins[ray], pixels_.directions[ray], surface_, x, y);
+    }
+    const Point& point = points_[ray];
+    if (!point.ok) return false;
+    *x = WithPoseGradient(point.x, point.dx, p);
+    *y = WithPoseGradient(point.y, point.dy, p);
+    return true;
+  }
+
+ private:
+  struct Point {
+    bool ok = false;
+    double x = 0.0, y = 0.0, dx[6] = {}, dy[6] = {};
+  };
+  const FitPixels& pixels_;
+  const WarpedSurface& surface_;
+  const double* pose_;
+  std::vector<Point> points_;  // per grid ray; those of used_ filled
+  std::vector<int> used_;
+  double at_pose_[6] = {};
+  bool valid_ = false;
+};
+
+template <typename T>
+T NormalCdf(const T& z) {
+  using std::erfc;
+  return T(0.5) * erfc(-z * T(M_SQRT1_2));
+}
+
+// The blurred step at each ink edge along one board axis, P(coordinate blurred by sigma <
+// edge), for one quadrature node: 0 or 1 beyond `reach` (6 sigma: under 1e-9 off), else
+// computed once per edge (a tag's rows of ink share their edges). The erfc and its
+// derivative's exp took a third of the fit's time.
+template <typename T>
+class EdgeCdfs {
+ public:
+  T At(double edge, const T& coordinate, const T& sigma, double reach) {
+    const double from_edge = edge - ScalarPart(coordinate);
+    if (from_edge > reach) return T(1.0);
+    if (from_edge < -reach) return T(0.0);
+    for (int k = 0; k < count_; ++k)
+      if (std::abs(edge_[k] - edge) < 1e-9) return value_[k];
+    const T value = NormalCdf((T(edge) - coordinate) / sigma);
+    if (count_ < kMaxEdges) edge_[count_] = edge, value_[count_++] = value;
+    return value;
+  }
+
+ private:
+  static constexpr int kMaxEdges = 8;
+  double edge_[kMaxEdges];
+  T value_[kMaxEdges];
+  int count_ = 0;
+};
+
 class PatchResidual {
  public:
   // The residual of fitted pixel `i`.
-  PatchResidual(const FitPixels& pixels, const std::vector<Eigen::Vector4d>& rectangles, const WarpedSurface& surface,
-                size_t i)
-      : pixels_(pixels), rectangles_(rectangles), surface_(surface), i_(i) {}
+  PatchResidual(const FitPixels& pixels, const std::vector<Eigen::Vector4d>& rectangles, const RaysOnBoard& rays, size_t i)
+      : pixels_(pixels), rectangles_(rectangles), rays_(rays), i_(i) {}
 
   template <typename T>
   bool operator()(const T* p, const T* rim, T* residuals) const {
     using std::exp;
     using std::sqrt;
-    using std::erfc;
-    // board_from_camera: the transpose of the pose's rotation.
-    T rotation[9];  // row-major camera_from_board
-    ceres::AngleAxisToRotationMatrix(p, ceres::RowMajorAdapter3x3(rotation));
-    const Eigen::Matrix<T, 3, 1> centre(p[3], p[4], p[5]);
-    // Where a ray meets the board, in board mm (x, y): its plane, then two Newton steps onto
-    // the warped surface (a sag of mm over a board of hundreds: the second step moves it by
-    // well under a micrometre). False when the ray runs along the plane or meets it behind
-    // its origin (Ceres then refuses the step).
-    const bool warped = !surface_.warp.IsZero();
-    const Eigen::Vector2d mid_mm = 0.5 * (surface_.low_mm + surface_.high_mm);
-    const Eigen::Vector2d half_mm = (0.5 * (surface_.high_mm - surface_.low_mm)).cwiseMax(1e-9);
-    auto board = [&](int ray, T* x, T* y) {
-      const Eigen::Vector3d& o = pixels_.origins[ray];
-      const Eigen::Vector3d& d = pixels_.directions[ray];
-      // The ray in the board frame: a + t b.
-      const T ox = T(o.x()) - centre.x(), oy = T(o.y()) - centre.y(), oz = T(o.z()) - centre.z();
-      T a[3], b[3];
-      for (int k = 0; k < 3; ++k) {
-        a[k] = rotation[k] * ox + rotation[3 + k] * oy + rotation[6 + k] * oz;
-        b[k] = rotation[k] * d.x() + rotation[3 + k] * d.y() + rotation[6 + k] * d.z();
-      }
-      if (!(std::abs(ScalarPart(b[2])) > 1e-9)) return false;
-      T t = -a[2] / b[2];
-      for (int step = 0; warped && step < 2; ++step) {
-        const T u = (a[0] + t * b[0] - T(mid_mm.x())) / T(half_mm.x()), v = (a[1] + t * b[1] - T(mid_mm.y())) / T(half_mm.y());
-        const T sag = T(surface_.warp.x_mm) * (T(1.0) - u * u) + T(surface_.warp.y_mm) * (T(1.0) - v * v);
-        const T slope_x = T(-2.0 * surface_.warp.x_mm / half_mm.x()) * u, slope_y = T(-2.0 * surface_.warp.y_mm / half_mm.y()) * v;
-        const T along = b[2] - slope_x * b[0] - slope_y * b[1];
-        if (!(std::abs(ScalarPart(along)) > 1e-9)) return false;
-        t -= (a[2] + t * b[2] - sag) / along;
-      }
-      if (!(ScalarPart(t) > 0.0)) return false;
-      *x = a[0] + t * b[0];
-      *y = a[1] + t * b[1];
-      return true;
-    };
-    auto cdf = [](const T& z) { return T(0.5) * erfc(-z * T(M_SQRT1_2)); };
     const T sigma_px = exp(p[6]), ink = p[7], paper = p[8];
     // The pixel's box (variance 1/12 px^2 per axis) and the blur, as one Gaussian in the
     // omni image, split in two: a part integrated by 3 x 3 Gauss-Hermite nodes, each
@@ -115,7 +216,7 @@ class PatchResidual {
     const std::array<int, 9>& ray = pixels_.rays[i];
     T bx[9], by[9];
     for (int j = 0; j < 9; ++j)
-      if (!board(ray[j], &bx[j], &by[j])) return false;
+      if (!rays_.At(ray[j], p, &bx[j], &by[j])) return false;
     // pixel -> board to second order: board mm per omni px along u (a, c) and v (b, d),
     // and the second derivatives.
     const T a = T(0.5) * (bx[5] - bx[3]), c = T(0.5) * (by[5] - by[3]), b = T(0.5) * (bx[7] - bx[1]),
@@ -134,13 +235,14 @@ class PatchResidual {
         const T x = bx[4] + a * du + b * dv + T(0.5) * (uu_x * du * du + vv_x * dv * dv) + uv_x * du * dv;
         const T y = by[4] + c * du + d * dv + T(0.5) * (uu_y * du * du + vv_y * dv * dv) + uv_y * du * dv;
         const double x0 = ScalarPart(x), y0 = ScalarPart(y);
+        EdgeCdfs<T> x_edges, y_edges;
         T ink_here(0.0);
         for (int k = pixels_.rectangle_begin[i]; k < pixels_.rectangle_begin[i + 1]; ++k) {
           const Eigen::Vector4d& r = rectangles_[pixels_.rectangles[k]];
           if (x0 < r(0) - reach_x || x0 > r(0) + r(2) + reach_x || y0 < r(1) - reach_y || y0 > r(1) + r(3) + reach_y)
             continue;
-          ink_here += (cdf((T(r(0) + r(2)) - x) / sx) - cdf((T(r(0)) - x) / sx)) *
-                      (cdf((T(r(1) + r(3)) - y) / sy) - cdf((T(r(1)) - y) / sy));
+          ink_here += (x_edges.At(r(0) + r(2), x, sx, reach_x) - x_edges.At(r(0), x, sx, reach_x)) *
+                      (y_edges.At(r(1) + r(3), y, sy, reach_y) - y_edges.At(r(1), y, sy, reach_y));
         }
         coverage += T(kNodeWeights[ju] * kNodeWeights[jv]) * ink_here;
       }
@@ -149,7 +251,7 @@ class PatchResidual {
     // The rim: the board's reflection gives way to the level beyond it, blurred like the
     // board (the product of the two blurred is the blur of the product to first order).
     if (std::isfinite(pixels_.inside_rim_px[i])) {
-      const T on_mirror = cdf((T(pixels_.inside_rim_px[i]) + rim[0]) / sqrt(variance_px2));
+      const T on_mirror = NormalCdf((T(pixels_.inside_rim_px[i]) + rim[0]) / sqrt(variance_px2));
       board_grey = rim[1] + (board_grey - rim[1]) * on_mirror;
     }
     residuals[0] = board_grey - T(pixels_.grey[i]);
@@ -163,7 +265,7 @@ class PatchResidual {
  private:
   const FitPixels& pixels_;
   const std::vector<Eigen::Vector4d>& rectangles_;
-  const WarpedSurface& surface_;
+  const RaysOnBoard& rays_;
   size_t i_;
 };
 
@@ -183,15 +285,14 @@ bool FitPrintedPatch(const CalibrationTarget& target, const cv::Mat& grey, const
   const WarpedSurface surface = WarpedSurface::Of(target, warp);
   const Eigen::Matrix3d rotation = start.camera_from_target_rotation.toRotationMatrix();  // camera_from_board
   const Eigen::Vector3d translation_mm = start.camera_from_target_translation_mm;
-  auto board_point = [&](const Eigen::Matrix3d& camera_from_board, const Eigen::Vector3d& board_origin_mm,
-                         const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Eigen::Vector2d* at) {
-    const Eigen::Vector3d normal = camera_from_board.col(2);
-    const double along = normal.dot(direction);
-    if (!(std::abs(along) > 1e-9)) return false;
-    const double t = normal.dot(board_origin_mm - origin) / along;
-    if (!(t > 0.0)) return false;
-    *at = (camera_from_board.transpose() * (origin + t * direction - board_origin_mm)).head<2>();
-    return true;
+  // Pixels are chosen where their rays meet the start pose's plane (the warp moves them by
+  // well under a pixel).
+  WarpedSurface plane = surface;
+  plane.warp = BoardWarp();
+  double start_rotation[9];  // row-major camera_from_board
+  Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>{start_rotation} = rotation;
+  auto board_point = [&](const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Eigen::Vector2d* at) {
+    return RayOnBoard(start_rotation, translation_mm.data(), origin, direction, plane, &at->x(), &at->y());
   };
 
   // A grid of pixels over the image box, with their rays; fitted are those whose ray meets
@@ -279,8 +380,8 @@ bool FitPrintedPatch(const CalibrationTarget& target, const cv::Mat& grey, const
       Eigen::Vector2d at;
       bool all_meet = true;
       for (int j = 0; j < 9 && all_meet; ++j)
-        if (j != 4) all_meet = board_point(rotation, translation_mm, pixels.origins[around[j]], pixels.directions[around[j]], &at);
-      if (!all_meet || !board_point(rotation, translation_mm, pixels.origins[i], pixels.directions[i], &at)) continue;
+        if (j != 4) all_meet = board_point(pixels.origins[around[j]], pixels.directions[around[j]], &at);
+      if (!all_meet || !board_point(pixels.origins[i], pixels.directions[i], &at)) continue;
       if ((at.array() < low_mm.array()).any() || (at.array() > high_mm.array()).any()) continue;
       pixels.grey.push_back(grey.at<uint8_t>(v0 + v, u0 + u));
       pixels.inside_rim_px.push_back(inside_rim_px[i]);
@@ -347,12 +448,14 @@ bool FitPrintedPatch(const CalibrationTarget& target, const cv::Mat& grey, const
   // pattern does not explain (the dark beyond a rim the sensor places too far out, a
   // finger on the board, a glint) weigh little.
   ceres::CauchyLoss loss(0.1 * std::max(parameters[8] - parameters[7], 1.0));  // outlives the problem
+  RaysOnBoard rays(pixels, surface, parameters);  // outlives the problem
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.evaluation_callback = &rays;
   ceres::Problem problem(problem_options);
   for (size_t i = 0; i < pixels.grey.size(); ++i)
     problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<PatchResidual, 1, kNumParams, kNumRimParams>(new PatchResidual(pixels, rectangles, surface, i)),
+        new ceres::AutoDiffCostFunction<PatchResidual, 1, kNumParams, kNumRimParams>(new PatchResidual(pixels, rectangles, rays, i)),
         &loss, parameters, rim);
   // The rim's parameters held where no fitted pixel is within the blur's reach of it.
   const double nearest_rim_px = pixels.inside_rim_px.empty() ? HUGE_VAL : *std::min_element(pixels.inside_rim_px.begin(), pixels.inside_rim_px.end());
