@@ -91,6 +91,7 @@ DEFINITIONS = [
 class Dataset:
     def __init__(self, name, label, target, images, guess=None):
         self.name, self.label, self.target, self.images, self.guess = name, label, target, images, guess
+        self.detect_options = []  # extra `calibrate --images` options for the corners both tools fit
 
 
 def datasets(real_dir):
@@ -148,7 +149,8 @@ def omnical_side(dataset, cli, out, log):
     import numpy as np
 
     log(f"{dataset.name}: omnical detects (calibrate --images)")
-    cli.calibrate(dataset.target, os.path.join(out, "images"), images=dataset.images, guess=dataset.guess)
+    cli.calibrate(dataset.target, os.path.join(out, "images"), images=dataset.images, guess=dataset.guess,
+                  extra=dataset.detect_options)
     detections = os.path.join(out, "images", "detections.json")
     data, image_size, all_views = read_detections(detections)
 
@@ -513,6 +515,8 @@ def main():
     parser.add_argument("--real-data", default=os.path.join(ROOT, "..", "shared", "real-data", "mei-parabolic"),
                         help="the mei-parabolic images (default: ../shared/real-data/mei-parabolic)")
     parser.add_argument("--datasets", help="comma-separated subset of the dataset names")
+    parser.add_argument("--checkerboard-edges", action="store_true",
+                        help="checkerboard corners from `calibrate --images --checkerboard-edges` (both tools fit them)")
     args = parser.parse_args()
 
     if not os.path.isdir(args.real_data):
@@ -530,6 +534,10 @@ def main():
         if unknown:
             raise BenchError(f"--datasets: unknown {', '.join(sorted(unknown))}")
         chosen = [d for d in chosen if d.name in wanted]
+    if args.checkerboard_edges:
+        for d in chosen:
+            if "checkerboard" in open(d.target).read():
+                d.detect_options = ["--checkerboard-edges"]
     knots = KNOTS[:1] if args.quick else KNOTS
     work = os.path.abspath(args.work) if args.work else tempfile.mkdtemp(prefix="mrcal_compare.")
     log = (lambda message: print(message, file=sys.stderr, flush=True))
