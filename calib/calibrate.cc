@@ -462,7 +462,12 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   // sensor is right. Through the design guess the patch edges bend, and the corners
   // carried a radius-dependent bias the mirror's size absorbed; re-detected through the
   // first fit they do not (30-view render: A 6 std off after one pass, 0.5 std after two;
-  // tests/cli/calibrate_render_test.sh). Checkerboards: the images where none was found
+  // tests/cli/calibrate_render_test.sh). Each pass fits the tags whole through the previous
+  // fit, and the tags at the rim across it. A third pass (opt-in) fits them through a
+  // sensor that saw the rim's corners, which the first did not: over 6 re-rendered
+  // realistic seeds fx's error went 14.4 -> 7.0 px RMS and error / std 1.18 -> 0.77
+  // (tests/bench/realistic_seeds.py), but on the bundled realistic set it used 12 fewer
+  // corners (rim tags whose edges then failed). Checkerboards: the images where none was found
   // are searched again through the fit's virtual views (calib/detect.h), and every
   // corner, found unrefined, is refined in patches through the fit (on grid steps of 20 px
   // and more, calib/refine_corners.h); a pass after the second only if it finds more
@@ -481,10 +486,8 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
       detections = CornersRefinedThrough(
           input, options, *refit_start, WarpOf(fit, fit_options),
           WithPredictedCheckerCorners(input.target, *refit_start, WarpOf(fit, fit_options), views.detections, fit, found));
-    } else if (pass < options.detection_passes) {
-      detections = FindCorners(input, options, refit_start, false, true, true, /*fit_whole_tags=*/false).detections;
     } else {
-      // The last pass fits the tags whole, and the tags the rim cuts across it, from their
+      // Every pass fits the tags whole, and the tags the rim cuts across it, from their
       // corners predicted through the previous fit (calib/checkerboard_completion.h).
       const DetectionSet raw = FindCorners(input, options, refit_start, false, true, /*refine=*/false).detections;
       detections = CornersRefinedThrough(

@@ -37,7 +37,7 @@ data_dir = os.path.join(source_dir, "datasets-synthetic")
 targets = {"checkerboard": "checkerboard-8x6-30mm.yaml", "aprilgrid": "aprilgrid-6x6-30mm.yaml"}
 option_sets = {
     "checkerboard": [[], ["--checkerboard-edges"], ["--view-weights"], ["--checkerboard-edges", "--view-weights"]],
-    "aprilgrid": [[], ["--view-weights"]],
+    "aprilgrid": [[], ["--detection-passes", "3"], ["--view-weights"]],
 }
 parameter_names = ["fx_px", "fy_px", "cx_px", "cy_px", "k1", "k2", "A_mm", "decenter_x_mm", "decenter_y_mm", "m_mm"]
 

@@ -186,7 +186,7 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
   field("robust_loss_px", &CalibrationRecord::robust_loss_px, "The robust loss scale used (px; 0: least squares).");
   field("covariance_ok", &CalibrationRecord::covariance_ok, "Whether the covariance could be computed.");
   field("start", &CalibrationRecord::start, "Where the fit started: the guess (its file) or the rim circle.");
-  field("detection_passes", &CalibrationRecord::detection_passes, "Detection passes made (2: re-detected through the first fit).");
+  field("detection_passes", &CalibrationRecord::detection_passes, "Detection passes made (2: re-detected through the first fit; 3: through the second).");
   field("nearest_target_mm", &CalibrationRecord::nearest_target_mm, "Distance of the nearest fitted board from the lens (mm).");
   field("farthest_target_mm", &CalibrationRecord::farthest_target_mm, "Distance of the farthest fitted board (mm).");
   field("views_left_out", &CalibrationRecord::views_left_out, "dict image -> why it was left out of the fit.");
@@ -697,7 +697,7 @@ design tolerances, as --sensor); without one the fit starts from the mirror's ri
 (one of omnical.PROFILES but tabulated; '' the guess's). fixed: blocks held (lens,
 lens_scale, principal_point, distortion, m, tilt, decenter, shape, poses; a list or 'a,b').
 loss_px: Huber scale (0: least squares). detection_passes: 2 re-detects through the
-first fit. threads: detection, board checks and the fit's Jacobians, 0 for all cores
+first fit, 3 (aprilgrids) once more through the second. threads: detection, board checks and the fit's Jacobians, 0 for all cores
 (the same result for any count). leave_one_out: also fit without each view.
 tolerances: design tolerances (dict name -> one std, or 'name=value,...').
 distances_mm / distances_n: where to predict the projection error (mm, or rim radii);
