@@ -293,7 +293,7 @@ std::string CalibrationOptions::Check() const {
   if (!(rim_field_deg >= 10.0 && rim_field_deg <= 170.0)) return "rim_field_deg: must lie in 10-170 deg";
   if (!(loss_px >= 0.0 && std::isfinite(loss_px))) return "loss_px: must be >= 0 and finite";
   if (max_iterations < 1) return "max_iterations: must be >= 1";
-  // Pass 2 re-detects through the first fit; later passes change nothing measurable.
+  // Pass 2 re-detects through the first fit; an aprilgrid's later passes through the last.
   if (detection_passes < 1 || detection_passes > 5) return "detection_passes: must be 1..5";
   if (threads < 1) return "threads: must be >= 1";
   for (double d : distances_mm)
@@ -334,8 +334,8 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   std::optional<RimCircle> rim;
   if (from_images) {
     // Checkerboard corners are refined in the second pass, through the first fit; aprilgrid
-    // tags are fitted whole (calib/tag_template_fit.h) only in the pass whose corners are
-    // kept: these only start the first fit when a second pass follows (the whole-tag fits
+    // tags are fitted whole (calib/tag_template_fit.h) in every pass after the first: this
+    // one's corners only start the first fit when a second pass follows (the whole-tag fits
     // are three quarters of a detection's time).
     DetectedImages found = FindCorners(input, options, input.guess, !input.guess, true,
                                        input.target.type() != CalibrationTarget::Type::kCheckerboard,

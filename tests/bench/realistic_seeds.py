@@ -3,7 +3,7 @@
 weighting option, scored against the truth (writes docs/realistic-seeds.md).
 
 The bundled realistic sets are one draw each: one set of random board poses, one noise.
-Whether an option (--checkerboard-edges, --view-weights) helps, and whether the reported
+Whether an option (--checkerboard-edges, --view-weights, --detection-passes 3) helps, and whether the reported
 std are honest, only shows over several draws. For each seed k the scene
 datasets-synthetic/scenes/realistic-<kind>.yaml is rendered with its noise seed and its
 random-pose seed both moved by k (the four fixed rim and inner-radius views stay), then
