@@ -18,6 +18,7 @@
 #include "correction/maps_json.h"
 #include "model/io/atomic_write.h"
 #include "model/first_error.h"
+#include "model/forced_unwind.h"
 #include "model/input_error.h"
 
 namespace omnical {
@@ -127,7 +128,7 @@ long UnwarpFrames(const Unwarper& unwarper, const std::function<bool(cv::Mat*)>&
         cv::Mat frame;
         if (!read(&frame) || !decoded.Push(std::move(frame))) break;
       }
-    } catch (...) {
+    } OMNICAL_RETHROW_FORCED_UNWIND catch (...) {
       error.Keep(std::current_exception());
     }
     decoded.Close();
@@ -137,7 +138,7 @@ long UnwarpFrames(const Unwarper& unwarper, const std::function<bool(cv::Mat*)>&
     writer = std::thread([&] {
       try {
         for (cv::Mat frame; unwarped.Pop(&frame);) write(frame);
-      } catch (...) {
+      } OMNICAL_RETHROW_FORCED_UNWIND catch (...) {
         error.Keep(std::current_exception());
         decoded.Close();  // stops the reader; the remap loop then ends
       }
@@ -155,7 +156,7 @@ long UnwarpFrames(const Unwarper& unwarper, const std::function<bool(cv::Mat*)>&
       ++frames;
       reporter.Step();
     }
-  } catch (...) {
+  } OMNICAL_RETHROW_FORCED_UNWIND catch (...) {
     error.Keep(std::current_exception());
   }
   decoded.Close();

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "model/first_error.h"
+#include "model/forced_unwind.h"
 #include "model/worker_threads.h"
 
 namespace omnical {
@@ -24,7 +25,7 @@ void ParallelRows(int rows, int threads, const RowFunction& row) {
     for (int v = next++; v < rows; v = next++) {
       try {
         row(v);
-      } catch (...) {
+      } OMNICAL_RETHROW_FORCED_UNWIND catch (...) {
         thrown.Keep(std::current_exception());
         next = rows;
       }

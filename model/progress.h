@@ -12,6 +12,8 @@
 #include <string>
 #include <utility>
 
+#include "model/forced_unwind.h"
+
 namespace omnical {
 
 struct ProgressUpdate {
@@ -68,7 +70,7 @@ class ProgressReporter {
       // The count read under the lock: reports from several threads never go backwards,
       // and the last one has the total.
       if (!callback_({stage_, done_.load(), total_})) cancelled_ = true;
-    } catch (...) {
+    } OMNICAL_RETHROW_FORCED_UNWIND catch (...) {
       if (!thrown_) thrown_ = std::current_exception();
       cancelled_ = true;
     }

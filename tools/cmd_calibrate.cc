@@ -102,10 +102,9 @@ Command CalibrateCommand() {
             sub.add_option("--max-iterations", library.max_iterations, "Solver iterations per stage")
                 ->check(CLI::Range(1, 100000))->capture_default_str();
             sub.add_option("--detection-passes", library.detection_passes,
-                           "With --images: pass 2 re-detects aprilgrid corners through the first fit's sensor, or "
-                           "refines checkerboard corners through it (and searches images without a board again), "
-                           "and fits again; pass 3 re-detects aprilgrid corners through the second fit, checkerboards "
-                           "only where it finds more boards (1: a single pass; checkerboard corners are then left as found)")
+                           "With --images: pass 2 re-detects aprilgrid corners (checkerboards: refines them, searches "
+                           "boardless images) through the first fit and fits again; pass 3 through the second (checkerboards: "
+                           "only if it finds more boards); 1: a single pass, checkerboard corners left as found")
                 ->check(CLI::Range(1, 5))->capture_default_str();
             sub.add_option("--tolerance", options->tolerance,
                            "Design tolerances (one std) as weak priors, name=value,...: e.g. m_mm=2,decenter_mm=1,"
