@@ -337,12 +337,12 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     // tags are fitted whole (calib/tag_template_fit.h) in every pass after the first: this
     // one's corners only start the first fit when a second pass follows (the whole-tag fits
     // are three quarters of a detection's time).
-    DetectedImages found = FindCorners(input, options, input.guess, !input.guess, true,
+    DetectedImages found = FindCorners(input, options, input.guess, true, true,
                                        input.target.type() != CalibrationTarget::Type::kCheckerboard,
                                        options.detection_passes < 2);
     detections = std::move(found.detections);
     warnings = std::move(found.warnings);
-    if (!input.guess) rim = MedianRimCircle(found.rim_circles);
+    rim = MedianRimCircle(found.rim_circles);
   } else {
     detections = *input.detections;
     // Corners fitted to another board than the one they were found on calibrate without
@@ -465,9 +465,8 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   // tests/cli/calibrate_render_test.sh). Each pass fits the tags whole through the previous
   // fit, and the tags at the rim across it. A third pass (opt-in) fits them through a
   // sensor that saw the rim's corners, which the first did not: over 6 re-rendered
-  // realistic seeds fx's error went 14.4 -> 7.0 px RMS and error / std 1.18 -> 0.77
-  // (tests/bench/realistic_seeds.py), but on the bundled realistic set it used 12 fewer
-  // corners (rim tags whose edges then failed). Checkerboards: the images where none was found
+  // realistic seeds used 98.57 -> 98.84 %, fx's error no better (8.0 -> 9.0 px RMS;
+  // tests/bench/realistic_seeds.py), for a pass's time. Checkerboards: the images where none was found
   // are searched again through the fit's virtual views (calib/detect.h), and every
   // corner, found unrefined, is refined in patches through the fit (on grid steps of 20 px
   // and more, calib/refine_corners.h); a pass after the second only if it finds more
@@ -477,22 +476,26 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   DetectionSet found = detections;  // checkerboards: the corners as found, not yet refined
   int passes_run = 1;
   for (int pass = 2; from_images && pass <= options.detection_passes && fit.sensor; ++pass) {
-    if (checkerboard && !FindMissedCheckerboards(input, options, *fit.sensor, &found) && pass > 2) break;
+    // Detected through the previous fit with its rim where the images show it
+    // (calib/rim_circle.h): the tags and junctions the rim cuts are fitted across it.
+    std::optional<Sensor> through = rim ? SensorWithImageRim(*fit.sensor, *rim) : std::nullopt;
+    if (!through) through = *fit.sensor;
+    if (checkerboard && !FindMissedCheckerboards(input, options, *through, &found) && pass > 2) break;
     refit_start = *fit.sensor;
     passes_run = pass;
     // The corners a fitted board lacks are predicted through this pass's start (the
     // previous fit) and kept where a junction is there (calib/checkerboard_completion.h).
     if (checkerboard) {
       detections = CornersRefinedThrough(
-          input, options, *refit_start, WarpOf(fit, fit_options),
-          WithPredictedCheckerCorners(input.target, *refit_start, WarpOf(fit, fit_options), views.detections, fit, found));
+          input, options, *through, WarpOf(fit, fit_options),
+          WithPredictedCheckerCorners(input.target, *through, WarpOf(fit, fit_options), views.detections, fit, found));
     } else {
       // Every pass fits the tags whole, and the tags the rim cuts across it, from their
       // corners predicted through the previous fit (calib/checkerboard_completion.h).
-      const DetectionSet raw = FindCorners(input, options, refit_start, false, true, /*refine=*/false).detections;
+      const DetectionSet raw = FindCorners(input, options, through, false, true, /*refine=*/false).detections;
       detections = CornersRefinedThrough(
-          input, options, *refit_start, WarpOf(fit, fit_options),
-          WithPredictedTagCorners(input.target, *refit_start, WarpOf(fit, fit_options), views.detections, fit, raw));
+          input, options, *through, WarpOf(fit, fit_options),
+          WithPredictedTagCorners(input.target, *through, WarpOf(fit, fit_options), views.detections, fit, raw));
     }
     // The skipped views are named again by this pass's ViewsForFit.
     warnings.erase(std::remove_if(warnings.begin(), warnings.end(),

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "calib/bilinear.h"
+#include "calib/bundle_fit.h"
 
 namespace omnical {
 
@@ -169,6 +170,28 @@ std::optional<RimCircle> MedianRimCircle(const std::vector<RimCircle>& circles) 
   out.inlier_fraction = median([](const RimCircle& c) { return c.inlier_fraction; });
   out.rms_px = median([](const RimCircle& c) { return c.rms_px; });
   return out;
+}
+
+std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& rim) {
+  constexpr int kPoints = 360;
+  constexpr double kMaxChange = 0.15;
+  // Wide enough that a circle beyond the sensor's rim still meets the mirror.
+  const Sensor wide = SensorWithWiderRim(sensor, 1.0 + 2.0 * kMaxChange);
+  const Eigen::Matrix3d& mirror_rotation = sensor.cache().camera_from_mirror_rotation;
+  const Eigen::Vector3d& mirror_translation = sensor.cache().camera_from_mirror_translation;
+  std::vector<double> radii_mm;
+  for (int k = 0; k < kPoints; ++k) {
+    const double angle = 2.0 * M_PI * k / kPoints;
+    const Eigen::Vector2d pixel = rim.centre_px + rim.radius_px * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    Eigen::Vector3d origin, direction;
+    if (wide.Unproject(pixel, &origin, &direction) != ProjectionStatus::kOk) continue;
+    radii_mm.push_back((mirror_rotation.transpose() * (origin - mirror_translation)).head<2>().norm());
+  }
+  if (radii_mm.size() < kPoints / 2) return std::nullopt;
+  std::nth_element(radii_mm.begin(), radii_mm.begin() + radii_mm.size() / 2, radii_mm.end());
+  const double rim_mm = radii_mm[radii_mm.size() / 2];
+  if (!(std::abs(rim_mm / sensor.rim_radius_mm() - 1.0) <= kMaxChange)) return std::nullopt;
+  return SensorWithWiderRim(sensor, rim_mm / sensor.rim_radius_mm());
 }
 
 }  // namespace omnical

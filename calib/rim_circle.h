@@ -16,6 +16,8 @@
 #include <optional>
 #include <vector>
 
+#include "model/sensor.h"
+
 namespace omnical {
 
 struct RimCircle {
@@ -31,5 +33,13 @@ std::optional<RimCircle> DetectRimCircle(const cv::Mat& grey);
 // The median centre and radius of several images' circles (the rim does not move on the
 // sensor); nothing if none was found.
 std::optional<RimCircle> MedianRimCircle(const std::vector<RimCircle>& circles);
+
+// The sensor with its rim radius where the images show it: the median mirror radius (mm)
+// of the reflection points seen along the circle. A fit places the mirror from the corners
+// it sees and takes the rim from the design (or, wider, from the farthest corner); near the
+// rim that put a realistic render's first fit's rim 7-12 px beyond the image's, and the
+// tags the rim cuts, fitted across a rim that was not there, were refused. Nothing when
+// under half the circle meets the mirror, or the radius would move by over 15 %.
+std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& rim);
 
 }  // namespace omnical

@@ -13,7 +13,8 @@
 namespace omnical {
 
 bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& sensor, const BoardWarp& warp,
-                    int tag, const std::array<Eigen::Vector2d, 4>& start_px, TagTemplateFit* fit, bool across_rim) {
+                    int tag, const std::array<Eigen::Vector2d, 4>& start_px, TagTemplateFit* fit, bool across_rim,
+                    double max_move_cells) {
   if (target.type() != CalibrationTarget::Type::kAprilGrid || target.family() != "tag36h11") return false;
   std::array<Eigen::Vector2d, 4> board_corners;
   int have = 0;
@@ -78,11 +79,12 @@ bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const 
   result.contrast = patch.contrast;
   result.rms_grey = patch.rms_grey;
   result.pixels = patch.pixels;
-  // Half a cell of the tag's longest side. Along its most foreshortened side that is more
+  // In cells of the tag's longest side. Along its most foreshortened side that is more
   // than a cell, but where the edge profiles failed the start is the detector's corner, off
   // by ~1 px radially near the rim (a bound of half a short cell, at least 1 px, refused 5
   // good rim tags on the realistic set); a fit one bit column over there shows in its
-  // residual, which the caller compares with the image's other tags.
+  // residual, which the caller compares with the image's other tags. The corners must not
+  // cross the cell's middle either way (max_move_cells < 1).
   const double cell_px = edge_px / 8.0;
   const WarpedSurface surface = WarpedSurface::Of(target, warp);
   for (int k = 0; k < 4; ++k) {
@@ -91,7 +93,7 @@ bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const 
             Eigen::Vector3d(board_corners[k].x(), board_corners[k].y(), surface.OffsetMm(board_corners[k].x(), board_corners[k].y())) +
         patch.pose.camera_from_target_translation_mm;
     if (wide.Project(corner_in_camera, &result.corners_px[k]) != ProjectionStatus::kOk) return false;
-    if (!((result.corners_px[k] - start_px[k]).norm() <= 0.5 * std::max(cell_px, 1.0))) return false;
+    if (!((result.corners_px[k] - start_px[k]).norm() <= max_move_cells * std::max(cell_px, 1.0))) return false;
     result.on_mirror[k] = OnMirrorWithMargin(sensor, result.corners_px[k], kCornerRimMarginPx);
     if (!across_rim && !result.on_mirror[k]) return false;
   }

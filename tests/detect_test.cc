@@ -407,6 +407,45 @@ TEST(TagTemplateFit, PutsTagCornersOnTheTruthMidFieldAndAtTheRim) {
   EXPECT_FALSE(FitTagTemplate(target, paper, sensor, warp, 0, start, &fit));
 }
 
+// A start off by 0.65 of a cell (the detector's corners where the edge profiles failed sat
+// 2.3-2.7 px off at the rim, cells 3.8-4.4 px): the fit still finds the tag, within the
+// bound above, but half a cell refuses it; max_move_cells = 0.75 (what RefineCorners allows
+// from the detector's corners) keeps it. Every complete mid-field tag of real004, the start
+// shifted alike for all four corners (a pose off, not a tag misshapen).
+TEST(TagTemplateFit, MovesAsFarAsItIsAllowed) {
+  const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/realistic-aprilgrid";
+  const Sensor sensor = LoadSensorYaml(set + "/sensor.yaml");
+  const DetectionSet truth = DetectionsFromGroundTruth({set + "/real004.json"});
+  const CalibrationTarget target = CalibrationTarget::FromYaml(truth.target_spec);
+  const BoardWarp warp{3.0, -1.5};
+  const ImageDetections& view = truth.images[0];
+  const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(grey.empty());
+  std::map<int, Eigen::Vector2d> expected = PixelsById(view);
+  int tags = 0, refused_at_half = 0, kept_at_three_quarters = 0;
+  double square_sum = 0.0;
+  for (int tag = 0; tag < 36; tag += 5) {
+    std::array<Eigen::Vector2d, 4> start;
+    bool complete = true;
+    for (int k = 0; k < 4 && complete; ++k) complete = expected.count(4 * tag + k) > 0;
+    if (!complete) continue;
+    double edge_px = 0.0;
+    for (int k = 0; k < 4; ++k) edge_px = std::max(edge_px, (expected[4 * tag + (k + 1) % 4] - expected[4 * tag + k]).norm());
+    const Eigen::Vector2d shift = 0.65 * edge_px / 8.0 * Eigen::Vector2d(std::cos(0.7), std::sin(0.7));
+    for (int k = 0; k < 4; ++k) start[k] = expected[4 * tag + k] + shift;
+    ++tags;
+    TagTemplateFit fit;
+    refused_at_half += !FitTagTemplate(target, grey, sensor, warp, tag, start, &fit);
+    if (!FitTagTemplate(target, grey, sensor, warp, tag, start, &fit, false, 0.75)) continue;
+    ++kept_at_three_quarters;
+    for (int k = 0; k < 4; ++k) square_sum += (fit.corners_px[k] - expected[4 * tag + k]).squaredNorm();
+  }
+  ASSERT_GE(tags, 5);
+  EXPECT_EQ(refused_at_half, tags);
+  EXPECT_EQ(kept_at_three_quarters, tags);
+  EXPECT_LT(std::sqrt(square_sum / std::max(1, 4 * kept_at_three_quarters)), 0.07);  // the mid-field bound above
+}
+
 // The checkerboard junction fit (calib/checker_junction_fit.h) on the realistic renders,
 // through the true sensor and the board's true warp, each junction from its true position
 // moved 0.5 px, the image's other corners at their truth: (1) the rim junctions whose outer
