@@ -153,7 +153,7 @@ std::optional<RimCircle> RimOfImages(const DetectionSet& detections) {
   return MedianRimCircle(circles);
 }
 
-// The corners, detected here (with the rim circles when there is no guess) or given.
+// The corners, detected here (with the images' rim circles if asked) or given.
 DetectedImages FindCorners(const CalibrationInput& input, const CalibrationOptions& options,
                            const std::optional<Sensor>& through, bool rim_circles, bool omni_search = true,
                            bool refine = true, bool fit_whole_tags = true, const BoardWarp& warp = BoardWarp()) {
@@ -337,7 +337,8 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     // tags are fitted whole (calib/tag_template_fit.h) in every pass after the first: this
     // one's corners only start the first fit when a second pass follows (the whole-tag fits
     // are three quarters of a detection's time).
-    DetectedImages found = FindCorners(input, options, input.guess, true, true,
+    // The rim circles start the fit without a guess, and place the rim for later passes.
+    DetectedImages found = FindCorners(input, options, input.guess, !input.guess || options.detection_passes > 1, true,
                                        input.target.type() != CalibrationTarget::Type::kCheckerboard,
                                        options.detection_passes < 2);
     detections = std::move(found.detections);

@@ -299,15 +299,19 @@ bool RefineInImage(const CalibrationTarget& target, const cv::Mat& image, const 
   return RefineSquareCorner(image, start, towards, distance / 8.0, refined);  // 8 cells across the black square
 }
 
-// Whether every patch pixel within radius_px of `centre` shows the mirror: the patch is 0
-// beyond the rim, which edge profiles read as ink (a predicted junction 4.5 px inside the
-// rim of the realistic checkerboard render went 2.6 px off along the rim's edge).
+// Whether the patch shows the mirror within radius_px of `centre`: the patch is 0 beyond
+// the rim, which edge profiles read as ink (a predicted junction 4.5 px inside the rim of
+// the realistic checkerboard render went 2.6 px off along the rim's edge). The circle's
+// edge is enough: the rim, or the camera's reflection, is far wider than a patch, so it
+// crosses the circle before it lies inside.
 bool ClearOfRim(const VirtualView& patch, const Eigen::Vector2d& centre, double radius_px) {
   Eigen::Vector2d omni_px;
-  for (double dv = -radius_px; dv <= radius_px; dv += 1.0)
-    for (double du = -radius_px; du <= radius_px; du += 1.0)
-      if (du * du + dv * dv <= radius_px * radius_px && !patch.ToOmni(centre + Eigen::Vector2d(du, dv), &omni_px)) return false;
-  return true;
+  const int steps = static_cast<int>(std::ceil(2.0 * M_PI * radius_px));  // 1 patch px apart
+  for (int k = 0; k < steps; ++k) {
+    const double angle = 2.0 * M_PI * k / steps;
+    if (!patch.ToOmni(centre + radius_px * Eigen::Vector2d(std::cos(angle), std::sin(angle)), &omni_px)) return false;
+  }
+  return patch.ToOmni(centre, &omni_px);
 }
 
 // The margin a refinement needs around the corner, in neighbour distances.

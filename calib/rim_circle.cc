@@ -173,24 +173,27 @@ std::optional<RimCircle> MedianRimCircle(const std::vector<RimCircle>& circles) 
 }
 
 std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& rim) {
-  constexpr int kPoints = 360;
-  constexpr double kMaxChange = 0.15;
+  constexpr int kCirclePoints = 360;
+  constexpr double kMaxRimChangeRatio = 0.05;  // seen: 1-2 %, a first fit's rim 7-12 px off
   // Wide enough that a circle beyond the sensor's rim still meets the mirror.
-  const Sensor wide = SensorWithWiderRim(sensor, 1.0 + 2.0 * kMaxChange);
+  const Sensor wide = SensorWithWiderRim(sensor, 1.0 + 3.0 * kMaxRimChangeRatio);
   const Eigen::Matrix3d& mirror_rotation = sensor.cache().camera_from_mirror_rotation;
   const Eigen::Vector3d& mirror_translation = sensor.cache().camera_from_mirror_translation;
   std::vector<double> radii_mm;
-  for (int k = 0; k < kPoints; ++k) {
-    const double angle = 2.0 * M_PI * k / kPoints;
+  for (int k = 0; k < kCirclePoints; ++k) {
+    const double angle = 2.0 * M_PI * k / kCirclePoints;
     const Eigen::Vector2d pixel = rim.centre_px + rim.radius_px * Eigen::Vector2d(std::cos(angle), std::sin(angle));
-    Eigen::Vector3d origin, direction;
-    if (wide.Unproject(pixel, &origin, &direction) != ProjectionStatus::kOk) continue;
-    radii_mm.push_back((mirror_rotation.transpose() * (origin - mirror_translation)).head<2>().norm());
+    Eigen::Vector3d origin, direction;  // origin: the reflection point
+    const ProjectionStatus status = wide.Unproject(pixel, &origin, &direction);
+    if (status == ProjectionStatus::kOk)
+      radii_mm.push_back((mirror_rotation.transpose() * (origin - mirror_translation)).head<2>().norm());
+    else if (status == ProjectionStatus::kOutsideMirror || status == ProjectionStatus::kMissesMirror)
+      radii_mm.push_back(HUGE_VAL);  // beyond what `wide` sees: counted, or the median would lean inwards
   }
-  if (radii_mm.size() < kPoints / 2) return std::nullopt;
+  if (radii_mm.size() < kCirclePoints / 2) return std::nullopt;
   std::nth_element(radii_mm.begin(), radii_mm.begin() + radii_mm.size() / 2, radii_mm.end());
   const double rim_mm = radii_mm[radii_mm.size() / 2];
-  if (!(std::abs(rim_mm / sensor.rim_radius_mm() - 1.0) <= kMaxChange)) return std::nullopt;
+  if (!(std::abs(rim_mm / sensor.rim_radius_mm() - 1.0) <= kMaxRimChangeRatio)) return std::nullopt;  // inf too
   return SensorWithWiderRim(sensor, rim_mm / sensor.rim_radius_mm());
 }
 

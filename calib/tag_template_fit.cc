@@ -83,8 +83,8 @@ bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const 
   // than a cell, but where the edge profiles failed the start is the detector's corner, off
   // by ~1 px radially near the rim (a bound of half a short cell, at least 1 px, refused 5
   // good rim tags on the realistic set); a fit one bit column over there shows in its
-  // residual, which the caller compares with the image's other tags. The corners must not
-  // cross the cell's middle either way (max_move_cells < 1).
+  // residual, which the caller compares with the image's other tags (a bound of a whole
+  // cell would let a fit one bit column over pass on its corners alone).
   const double cell_px = edge_px / 8.0;
   const WarpedSurface surface = WarpedSurface::Of(target, warp);
   for (int k = 0; k < 4; ++k) {
