@@ -14,7 +14,7 @@ namespace omnical {
 
 bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& sensor, const BoardWarp& warp,
                     int tag, const std::array<Eigen::Vector2d, 4>& start_px, TagTemplateFit* fit, bool across_rim,
-                    double max_move_cells) {
+                    const std::array<double, 4>& max_move_cells) {
   if (target.type() != CalibrationTarget::Type::kAprilGrid || target.family() != "tag36h11") return false;
   std::array<Eigen::Vector2d, 4> board_corners;
   int have = 0;
@@ -93,7 +93,7 @@ bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const 
             Eigen::Vector3d(board_corners[k].x(), board_corners[k].y(), surface.OffsetMm(board_corners[k].x(), board_corners[k].y())) +
         patch.pose.camera_from_target_translation_mm;
     if (wide.Project(corner_in_camera, &result.corners_px[k]) != ProjectionStatus::kOk) return false;
-    if (!((result.corners_px[k] - start_px[k]).norm() <= max_move_cells * std::max(cell_px, 1.0))) return false;
+    if (!((result.corners_px[k] - start_px[k]).norm() <= max_move_cells[k] * std::max(cell_px, 1.0))) return false;
     result.on_mirror[k] = OnMirrorWithMargin(sensor, result.corners_px[k], kCornerRimMarginPx);
     if (!across_rim && !result.on_mirror[k]) return false;
   }

@@ -35,7 +35,7 @@ struct TagTemplateFit {
 // `warp`, from `start_px`, its corners in the omni image `grey` (8-bit). False when it
 // cannot: too few pixels on the mirror, the fit does not converge, no contrast, the pattern
 // does not match (residual over a quarter of the contrast), an implausible blur, or a
-// corner moved more than max_move_cells of a cell (of the tag's longest side).
+// corner moved more than its max_move_cells of a cell (of the tag's longest side).
 // across_rim: a tag the mirror's rim cuts (calib/checkerboard_completion.h predicts it):
 // start_px may lie beyond the rim (where a wider mirror would show them), the rim is
 // modelled instead of kept clear of; a corner must lie within kRimClearancePx of the rim (a
@@ -43,6 +43,6 @@ struct TagTemplateFit {
 // Elsewhere no corner may lie within kRimClearancePx of the rim.
 bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& sensor, const BoardWarp& warp,
                     int tag, const std::array<Eigen::Vector2d, 4>& start_px, TagTemplateFit* fit,
-                    bool across_rim = false, double max_move_cells = 0.5);
+                    bool across_rim = false, const std::array<double, 4>& max_move_cells = {0.5, 0.5, 0.5, 0.5});
 
 }  // namespace omnical

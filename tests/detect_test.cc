@@ -436,7 +436,7 @@ TEST(TagTemplateFit, MovesAsFarAsItIsAllowed) {
     ++tags;
     TagTemplateFit fit;
     refused_at_half += !FitTagTemplate(target, grey, sensor, warp, tag, start, &fit);
-    if (!FitTagTemplate(target, grey, sensor, warp, tag, start, &fit, false, 0.75)) continue;
+    if (!FitTagTemplate(target, grey, sensor, warp, tag, start, &fit, false, {0.75, 0.75, 0.75, 0.75})) continue;
     ++kept_at_three_quarters;
     for (int k = 0; k < 4; ++k) square_sum += (fit.corners_px[k] - expected[4 * tag + k]).squaredNorm();
   }
