@@ -479,8 +479,14 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
   for (int pass = 2; from_images && pass <= options.detection_passes && fit.sensor; ++pass) {
     // Detected through the previous fit with its rim where the images show it
     // (calib/rim_circle.h): the tags and junctions the rim cuts are fitted across it.
-    std::optional<Sensor> through = rim ? SensorWithImageRim(*fit.sensor, *rim) : std::nullopt;
+    std::string rim_refused;
+    std::optional<Sensor> through = rim ? SensorWithImageRim(*fit.sensor, *rim, &rim_refused) : std::nullopt;
     if (!through) through = *fit.sensor;
+    if (!rim_refused.empty() &&
+        std::none_of(warnings.begin(), warnings.end(), [](const CalibrationWarning& w) { return w.code == WarningCode::kImageRimNotUsed; }))
+      warnings.push_back({WarningCode::kImageRimNotUsed, "rim_circle",
+                          rim_refused + "; detection pass " + std::to_string(pass) +
+                              " looked through the fit's own rim (tags or junctions the rim cuts may be lost)"});
     if (checkerboard && !FindMissedCheckerboards(input, options, *through, &found) && pass > 2) break;
     refit_start = *fit.sensor;
     passes_run = pass;

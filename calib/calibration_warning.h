@@ -26,6 +26,7 @@ enum class WarningCode {
   kHeldOutWorse,              // held-out views fit much worse than the training views
   kKnotCountReplaced,         // subject: knots; the folds' count fitted no valid mirror, the next was used
   kBoardScreenStopped,        // the board-size screen would refuse more than a quarter of the views: it kept them
+  kImageRimNotUsed,           // subject: rim_circle; the images' rim is not this fit's mirror rim: detection kept the fit's
 };
 
 // A stable lower-case name for programs (Python's CalibrationWarning.code), e.g.

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
+#include <string>
 
 #include "calib/bilinear.h"
 #include "calib/bundle_fit.h"
@@ -172,7 +174,7 @@ std::optional<RimCircle> MedianRimCircle(const std::vector<RimCircle>& circles) 
   return out;
 }
 
-std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& rim) {
+std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& rim, std::string* why) {
   constexpr int kCirclePoints = 360;
   constexpr double kMaxRimChangeRatio = 0.05;  // seen: 1-2 %, a first fit's rim 7-12 px off
   // Wide enough that a circle beyond the sensor's rim still meets the mirror.
@@ -190,10 +192,27 @@ std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& 
     else if (status == ProjectionStatus::kOutsideMirror || status == ProjectionStatus::kMissesMirror)
       radii_mm.push_back(HUGE_VAL);  // beyond what `wide` sees: counted, or the median would lean inwards
   }
-  if (radii_mm.size() < kCirclePoints / 2) return std::nullopt;
+  char circle[160];
+  std::snprintf(circle, sizeof circle, "the images' rim circle (centre %.1f, %.1f px, radius %.1f px)", rim.centre_px.x(),
+                rim.centre_px.y(), rim.radius_px);
+  if (radii_mm.size() < kCirclePoints / 2) {
+    if (why) *why = std::string(circle) + " meets the fit's mirror at under half its points";
+    return std::nullopt;
+  }
   std::nth_element(radii_mm.begin(), radii_mm.begin() + radii_mm.size() / 2, radii_mm.end());
   const double rim_mm = radii_mm[radii_mm.size() / 2];
-  if (!(std::abs(rim_mm / sensor.rim_radius_mm() - 1.0) <= kMaxRimChangeRatio)) return std::nullopt;  // inf too
+  if (!(std::abs(rim_mm / sensor.rim_radius_mm() - 1.0) <= kMaxRimChangeRatio)) {  // inf too
+    if (why) {
+      char text[320];
+      if (std::isfinite(rim_mm))
+        std::snprintf(text, sizeof text, "%s is a mirror radius of %.2f mm through the fit, whose rim is %.2f mm: over %.0f %% apart",
+                      circle, rim_mm, sensor.rim_radius_mm(), 100.0 * kMaxRimChangeRatio);
+      else
+        std::snprintf(text, sizeof text, "%s lies mostly beyond the fit's mirror (rim %.2f mm)", circle, sensor.rim_radius_mm());
+      *why = text;
+    }
+    return std::nullopt;
+  }
   return SensorWithWiderRim(sensor, rim_mm / sensor.rim_radius_mm());
 }
 

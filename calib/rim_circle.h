@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "model/sensor.h"
@@ -40,7 +41,7 @@ std::optional<RimCircle> MedianRimCircle(const std::vector<RimCircle>& circles);
 // rim that put a realistic render's first fit's rim 7-12 px beyond the image's, and the
 // tags the rim cuts, fitted across a rim that was not there, were refused. Nothing when
 // under half the circle lies in the image, or the radius would move by over 5 % (a circle
-// that is not this mirror's rim).
-std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& rim);
+// that is not this mirror's rim); then `why` (if given) says which, in one line.
+std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& rim, std::string* why = nullptr);
 
 }  // namespace omnical

@@ -98,12 +98,19 @@ TEST(RimCircle, MovesASensorsRimOntoTheImages) {
     ASSERT_TRUE(moved) << factor;
     EXPECT_NEAR(moved->rim_radius_mm(), truth.rim_radius_mm(), 0.1) << factor;
   }
+  // Refused with the reason calibrate's warning (image_rim_not_used) passes on: the circle,
+  // and the radius it would give the mirror where it meets the mirror.
   RimCircle half = *circle;
   half.radius_px *= 0.5;
-  EXPECT_FALSE(SensorWithImageRim(truth, half));
+  std::string why;
+  EXPECT_FALSE(SensorWithImageRim(truth, half, &why));
+  EXPECT_NE(why.find("radius " + std::to_string(static_cast<int>(half.radius_px))), std::string::npos) << why;
+  EXPECT_NE(why.find("whose rim is 43.9"), std::string::npos) << why;
   RimCircle beyond = *circle;
   beyond.radius_px *= 1.3;
-  EXPECT_FALSE(SensorWithImageRim(truth, beyond));
+  why.clear();
+  EXPECT_FALSE(SensorWithImageRim(truth, beyond, &why));
+  EXPECT_NE(why.find("meets the fit's mirror at under half its points"), std::string::npos) << why;  // the image ends first
 }
 
 }  // namespace
