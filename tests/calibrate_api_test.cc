@@ -12,6 +12,7 @@
 #include <type_traits>
 #include <variant>
 
+#include "calib/bundle_fit.h"
 #include "calib/calibrate.h"
 #include "calib/calibration_json.h"
 #include "calib/detect.h"
@@ -235,6 +236,31 @@ TEST(CalibrateApi, TinyImagesAndThrowingCallbacksDoNotCrash) {
   EXPECT_THROW(RefineFoundCorners(target, found, [](const std::string&) -> cv::Mat { throw std::runtime_error("no pixels"); },
                                   options),
                std::runtime_error);
+}
+
+// A guess whose rim is 10 % wider than the mirror's: the first fit keeps it, and the
+// images' rim circle (the true rim, 9 % inside) is refused as this mirror's rim for the
+// second detection pass, which says so (image_rim_not_used) and looks through the fit's own
+// rim. Four of the renders (two detection passes, ~5 s).
+TEST(CalibrateApi, ARimCircleNotTheFitsRimIsReported) {
+  CalibrationInput input = InputFromTruth();
+  input.detections.reset();
+  for (const char* view : {"near000.png", "near001.png", "near002.png", "near003.png"})
+    input.image_paths.push_back(testing::SourceDir() + kSet + "/" + view);
+  input.source = "four renders";
+  input.guess = SensorWithWiderRim(*input.guess, 1.1);
+  CalibrationOptions options;
+  options.threads = 2;
+  const CalibrationResult result = Calibrate(input, options);
+  int reported = 0;
+  for (const CalibrationWarning& w : result.warnings)
+    if (w.code == WarningCode::kImageRimNotUsed) {
+      ++reported;
+      EXPECT_EQ(w.subject, "rim_circle");
+      EXPECT_NE(w.text.find("whose rim is 48.29 mm: over 5 % apart"), std::string::npos) << w.text;
+      EXPECT_NE(w.text.find("detection pass 2"), std::string::npos) << w.text;
+    }
+  EXPECT_EQ(reported, 1);
 }
 
 }  // namespace
