@@ -84,7 +84,7 @@ TEST(RimCircle, AgreesAcrossTheRealImages) {
 // sensor with its rim 4 % too wide or too narrow (~20 px at the rim) comes back to the
 // truth's 43.9 mm within 0.1 mm (~1 px there: the circle sits 0.3-0.7 px inside the true
 // rim, the blur's midpoint, and the misaligned rim is not quite a circle). A circle at half
-// the radius would move the rim by far more than 5 %: nothing; nor one 30 % wider (beyond
+// the radius would move the rim by far more than 10 %: nothing; nor one 30 % wider (beyond
 // the mirror's widest point).
 TEST(RimCircle, MovesASensorsRimOntoTheImages) {
   const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/realistic-aprilgrid";
