@@ -482,12 +482,13 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     std::string rim_refused;
     std::optional<Sensor> through = rim ? SensorWithImageRim(*fit.sensor, *rim, &rim_refused) : std::nullopt;
     if (!through) through = *fit.sensor;
+    if (checkerboard && !FindMissedCheckerboards(input, options, *through, &found) && pass > 2) break;
+    // Said of a pass whose corners are kept (after the break above), once.
     if (!rim_refused.empty() &&
         std::none_of(warnings.begin(), warnings.end(), [](const CalibrationWarning& w) { return w.code == WarningCode::kImageRimNotUsed; }))
       warnings.push_back({WarningCode::kImageRimNotUsed, "rim_circle",
                           rim_refused + "; detection pass " + std::to_string(pass) +
                               " looked through the fit's own rim (tags or junctions the rim cuts may be lost)"});
-    if (checkerboard && !FindMissedCheckerboards(input, options, *through, &found) && pass > 2) break;
     refit_start = *fit.sensor;
     passes_run = pass;
     // The corners a fitted board lacks are predicted through this pass's start (the

@@ -96,7 +96,7 @@ ceres::Jet<double, N> WithPoseGradient(double value, const double* gradient, con
 
 // The fitted pixels' rays on the board at Ceres' evaluation point, with their derivatives
 // by the pose, once per evaluation: each ray serves the residuals of up to 9 pixels (the
-// 3 x 3 around each), intersected in every one of them, in Jets of all 11 parameters.
+// 3 x 3 around each), intersected in every one of them, in Jets of all the fit's parameters.
 class RaysOnBoard : public ceres::EvaluationCallback {
  public:
   // `pose`: the problem's parameter block (its first 6 values are the pose).
@@ -184,8 +184,8 @@ ceres::Jet<double, N> NormalCdf(const ceres::Jet<double, N>& z) {
 
 // The blurred step at each ink edge along one board axis, P(coordinate blurred by sigma <
 // edge), for one quadrature node: 0 or 1 beyond `reach` (6 sigma: under 1e-9 off), else
-// computed once per edge (a tag's rows of ink share their edges). The erfc and its
-// derivative's exp took a third of the fit's time.
+// computed once per edge (a tag's rows of ink share their edges). The CDF and its
+// density took a third of the fit's time.
 template <typename T>
 class EdgeCdfs {
  public:
@@ -250,7 +250,7 @@ class PatchResidual {
     const T uv_x = T(0.25) * (bx[8] - bx[6] - bx[2] + bx[0]), uv_y = T(0.25) * (by[8] - by[6] - by[2] + by[0]);
     const T sx = sqrt(residual_variance * (a * a + b * b)), sy = sqrt(residual_variance * (c * c + d * d));
     // Ink within 6 sigma on both axes (farther it adds under 1e-9): tested on the scalar
-    // parts before any erfc of a Jet.
+    // parts before any CDF of a Jet.
     const double reach_x = 6.0 * ScalarPart(sx), reach_y = 6.0 * ScalarPart(sy);
     T coverage(0.0);
     for (int ju = 0; ju < 3; ++ju)

@@ -199,7 +199,7 @@ std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& 
   std::snprintf(circle, sizeof circle, "the images' rim circle (centre %.1f, %.1f px, radius %.1f px)", rim.centre_px.x(),
                 rim.centre_px.y(), rim.radius_px);
   if (radii_mm.size() < kCirclePoints / 2) {
-    if (why) *why = std::string(circle) + " meets the fit's mirror at under half its points";
+    if (why) *why = std::string(circle) + " lies in the image at under half its points";
     return std::nullopt;
   }
   std::nth_element(radii_mm.begin(), radii_mm.begin() + radii_mm.size() / 2, radii_mm.end());
