@@ -309,7 +309,33 @@ class HeldRimPatchResidual {
   const double* rim_;
 };
 
+// The radius of a reflection point (camera frame) about the mirror's axis, mm.
+double MirrorRadiusMm(const Sensor& sensor, const Eigen::Vector3d& point_in_camera_mm) {
+  const ProjectionCache& cache = sensor.cache();
+  return (cache.camera_from_mirror_rotation.transpose() * (point_in_camera_mm - cache.camera_from_mirror_translation))
+      .head<2>()
+      .norm();
+}
+
+// How far inside the rim (omni px) a point of mirror radius radius_mm is, the radius
+// changing by (dr_du, dr_dv) mm per px there.
+double RimDistancePx(double rim_mm, double radius_mm, double dr_du, double dr_dv) {
+  return (rim_mm - radius_mm) / std::hypot(dr_du, dr_dv);
+}
+
 }  // namespace
+
+double InsideRimPx(const Sensor& sensor, const Sensor& wider, const Eigen::Vector2d& pixel) {
+  double radius_mm[5];  // at pixel + (0, 0), (-1, 0), (1, 0), (0, -1), (0, 1)
+  const Eigen::Vector2d steps[5] = {{0.0, 0.0}, {-1.0, 0.0}, {1.0, 0.0}, {0.0, -1.0}, {0.0, 1.0}};
+  for (int k = 0; k < 5; ++k) {
+    Eigen::Vector3d origin, direction;
+    if (wider.Unproject(pixel + steps[k], &origin, &direction) != ProjectionStatus::kOk) return std::nan("");
+    radius_mm[k] = MirrorRadiusMm(sensor, origin);
+  }
+  return RimDistancePx(sensor.rim_radius_mm(), radius_mm[0], 0.5 * (radius_mm[2] - radius_mm[1]),
+                       0.5 * (radius_mm[4] - radius_mm[3]));
+}
 
 bool OnMirrorWithMargin(const Sensor& sensor, const Eigen::Vector2d& pixel, int margin_px) {
   for (int dv = -margin_px; dv <= margin_px; ++dv)
@@ -363,17 +389,14 @@ bool FitPrintedPatch(const CalibrationTarget& target, const cv::Mat& grey, const
   std::vector<char> inside(statuses.size(), 0);
   std::vector<double> inside_rim_px(statuses.size(), HUGE_VAL);
   if (region.model_rim) {
-    const Eigen::Matrix3d& mirror_rotation = sensor.cache().camera_from_mirror_rotation;
-    const Eigen::Vector3d& mirror_translation = sensor.cache().camera_from_mirror_translation;
     std::vector<double> radius_mm(statuses.size(), std::nan(""));
     for (size_t i = 0; i < statuses.size(); ++i)
-      if (statuses[i] == ProjectionStatus::kOk)
-        radius_mm[i] = (mirror_rotation.transpose() * (pixels.origins[i] - mirror_translation)).head<2>().norm();
+      if (statuses[i] == ProjectionStatus::kOk) radius_mm[i] = MirrorRadiusMm(sensor, pixels.origins[i]);
     for (int v = 1; v + 1 < height; ++v)
       for (int u = 1; u + 1 < width; ++u) {
         const int i = v * width + u;
         const double du = 0.5 * (radius_mm[i + 1] - radius_mm[i - 1]), dv = 0.5 * (radius_mm[i + width] - radius_mm[i - width]);
-        inside_rim_px[i] = (sensor.rim_radius_mm() - radius_mm[i]) / std::hypot(du, dv);  // NaN without all four
+        inside_rim_px[i] = RimDistancePx(sensor.rim_radius_mm(), radius_mm[i], du, dv);  // NaN without all four
       }
     for (size_t i = 0; i < statuses.size(); ++i) inside[i] = statuses[i] == ProjectionStatus::kOk && radius_mm[i] <= sensor.rim_radius_mm();
   } else {
@@ -478,7 +501,7 @@ bool FitPrintedPatch(const CalibrationTarget& target, const cv::Mat& grey, const
   parameters[6] = std::log(0.8);
   parameters[7] = sorted[sorted.size() / 10];
   parameters[8] = sorted[sorted.size() * 9 / 10];
-  double rim[kNumRimParams] = {0.0, parameters[7]};  // shift bounded below
+  double rim[kNumRimParams] = {0.0, parameters[7]};  // shift bounded both ways (kMaxRimShiftPx)
   if (!beyond.empty()) {
     std::nth_element(beyond.begin(), beyond.begin() + beyond.size() / 2, beyond.end());
     rim[1] = beyond[beyond.size() / 2];
@@ -536,6 +559,7 @@ bool FitPrintedPatch(const CalibrationTarget& target, const cv::Mat& grey, const
   result.blur_px = std::exp(parameters[6]);
   result.contrast = parameters[8] - parameters[7];
   result.pixels = static_cast<int>(pixels.grey.size());
+  result.rim_shift_px = rim_held || !(rim[0] < kMaxRimShiftPx - 1e-6) ? 0.0 : rim[0];
   ceres::Problem::EvaluateOptions plain;
   plain.apply_loss_function = false;
   double plain_cost = 0.0;

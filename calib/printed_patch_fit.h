@@ -62,12 +62,23 @@ constexpr int kRimClearancePx = 3;
 // the sensor's rim error make it moot.
 bool OnMirrorWithMargin(const Sensor& sensor, const Eigen::Vector2d& pixel, int margin_px);
 
+// A pixel's signed distance inside the sensor's rim, omni px (negative beyond it): how far
+// its reflection point's radius falls short of the rim's, over that radius's gradient
+// across the image. The rays come from `wider`, SensorWithWiderRim(sensor, 1.15) (as the
+// fits' pixels'); NaN where the rays around the pixel miss even that mirror.
+double InsideRimPx(const Sensor& sensor, const Sensor& wider, const Eigen::Vector2d& pixel);
+
 struct PatchFit {
   TargetPose pose;         // the fitted plane's camera_from_target
   double blur_px = 0.0;    // the fitted Gaussian's sigma, omni px
   double contrast = 0.0;   // paper - ink, grey levels
   double rms_grey = 0.0;   // the fit's residual RMS (plain, no loss), grey levels
   int pixels = 0;          // fitted pixels
+  // With the rim modelled: how far beyond the sensor's rim the image's lies here, omni px
+  // (a pixel is InsideRimPx + rim_shift_px inside the fitted rim); 0 where no fitted pixel
+  // came near enough the rim to say (the shift then held), and where the shift ended on its
+  // outer bound (not measured, only pushed there: the sensor's rim is then the safer one).
+  double rim_shift_px = 0.0;
 };
 
 // Fits the target's ink, on the board bent by `warp` (calib/board_warp.h), over `region` of

@@ -15,19 +15,21 @@
 
 namespace omnical {
 
-// A tag's corner fitted across the rim is kept only this far inside it and more: on the
-// realistic aprilgrid renders one 1 px inside the fitted rim lay beyond the render's.
+// A tag's corner fitted across the rim is kept only this far inside the rim the fit placed
+// (PatchFit::rim_shift_px) and more: the rim's blur makes nearer ones moot, and on the
+// realistic aprilgrid renders one 1 px inside the sensor's rim lay beyond the render's.
 constexpr int kCornerRimMarginPx = 2;
 
 struct TagTemplateFit {
   std::array<Eigen::Vector2d, 4> corners_px;  // corner ids 4 tag + k, k = 0..3 (calib/target.h)
-  // Across the rim: which corners lie on the mirror, kCornerRimMarginPx and more inside its
-  // rim (the others' corners_px are where the mirror would show them were it wider).
+  // Across the rim: which corners lie on the mirror, kCornerRimMarginPx and more inside the
+  // fitted rim (the others' corners_px are where the mirror would show them were it wider).
   std::array<bool, 4> on_mirror = {true, true, true, true};
   double blur_px = 0.0;                       // the fitted Gaussian's sigma, omni px
   double contrast = 0.0;                      // paper - ink, grey levels
   double rms_grey = 0.0;                      // the fit's residual RMS, grey levels
   int pixels = 0;                             // fitted pixels
+  double rim_shift_px = 0.0;                  // across the rim: PatchFit::rim_shift_px
 };
 
 // Fits the tag with id `tag` (its corners' ids 4 tag + k) of an aprilgrid (tag36h11: a
