@@ -101,7 +101,7 @@ bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const 
     // 0.04-0.06 px from the truth. The wider mirror still keeps them off the camera's
     // reflection.
     result.on_mirror[k] =
-        across_rim ? InsideRimPx(sensor, wide, result.corners_px[k]) + patch.rim_shift_px >= kCornerRimMarginPx &&
+        across_rim ? InsideRimPx(sensor, wide, result.corners_px[k]) + patch.rim_shift_px >= kFittedRimMarginPx &&
                          OnMirrorWithMargin(wide, result.corners_px[k], kCornerRimMarginPx)
                    : OnMirrorWithMargin(sensor, result.corners_px[k], kCornerRimMarginPx);
     if (!across_rim && !result.on_mirror[k]) return false;

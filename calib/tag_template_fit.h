@@ -15,14 +15,26 @@
 
 namespace omnical {
 
-// A tag's corner fitted across the rim is kept only this far inside the rim the fit placed
-// (PatchFit::rim_shift_px) and more: the rim's blur makes nearer ones moot, and on the
+// A tag's corner fitted whole away from the rim is kept only this far inside the sensor's
+// rim and more (a pixel box; nearer, the tag is fitted across the rim instead): on the
 // realistic aprilgrid renders one 1 px inside the sensor's rim lay beyond the render's.
 constexpr int kCornerRimMarginPx = 2;
 
+// A tag's corner fitted across the rim is kept this far inside the rim the fit placed
+// (PatchFit::rim_shift_px) and more. That rim is within ~0.2 px of the image's (a sensor's
+// rim moved 1.8-1.9 px: fitted shifts 1.75-1.85 px, TagTemplateFit.KeepsRimCornersByTheRimItFitted);
+// over 6 realistic aprilgrid seeds the corners kept 1-2 px inside the true rim came out
+// 0.11 px RMS from the truth (0.17 worst), those 2-3 px inside 0.066 px, mid-field 0.05.
+constexpr double kFittedRimMarginPx = 1.0;
+
+// How far (cells of the tag's longest side) a whole-tag fit may move a corner that started
+// where the detector put it (its edge profiles failed), and one the edge profiles placed.
+constexpr double kDetectorCornerMaxMoveCells = 1.25;
+constexpr double kRefinedCornerMaxMoveCells = 0.5;
+
 struct TagTemplateFit {
   std::array<Eigen::Vector2d, 4> corners_px;  // corner ids 4 tag + k, k = 0..3 (calib/target.h)
-  // Across the rim: which corners lie on the mirror, kCornerRimMarginPx and more inside the
+  // Across the rim: which corners lie on the mirror, kFittedRimMarginPx and more inside the
   // fitted rim (the others' corners_px are where the mirror would show them were it wider).
   std::array<bool, 4> on_mirror = {true, true, true, true};
   double blur_px = 0.0;                       // the fitted Gaussian's sigma, omni px
@@ -45,6 +57,7 @@ struct TagTemplateFit {
 // Elsewhere no corner may lie within kRimClearancePx of the rim.
 bool FitTagTemplate(const CalibrationTarget& target, const cv::Mat& grey, const Sensor& sensor, const BoardWarp& warp,
                     int tag, const std::array<Eigen::Vector2d, 4>& start_px, TagTemplateFit* fit,
-                    bool across_rim = false, const std::array<double, 4>& max_move_cells = {0.5, 0.5, 0.5, 0.5});
+                    bool across_rim = false, const std::array<double, 4>& max_move_cells = {kRefinedCornerMaxMoveCells, kRefinedCornerMaxMoveCells,
+                                                                                     kRefinedCornerMaxMoveCells, kRefinedCornerMaxMoveCells});
 
 }  // namespace omnical
