@@ -311,10 +311,7 @@ class HeldRimPatchResidual {
 
 // The radius of a reflection point (camera frame) about the mirror's axis, mm.
 double MirrorRadiusMm(const Sensor& sensor, const Eigen::Vector3d& point_in_camera_mm) {
-  const ProjectionCache& cache = sensor.cache();
-  return (cache.camera_from_mirror_rotation.transpose() * (point_in_camera_mm - cache.camera_from_mirror_translation))
-      .head<2>()
-      .norm();
+  return sensor.cache().InMirrorFrame(point_in_camera_mm).head<2>().norm();
 }
 
 // How far inside the rim (omni px) a point of mirror radius radius_mm is, the radius

@@ -182,8 +182,6 @@ std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& 
   constexpr double kMaxRimChangeRatio = 0.10;
   // Wide enough that a circle beyond the sensor's rim still meets the mirror.
   const Sensor wide = SensorWithWiderRim(sensor, 1.0 + 3.0 * kMaxRimChangeRatio);
-  const Eigen::Matrix3d& mirror_rotation = sensor.cache().camera_from_mirror_rotation;
-  const Eigen::Vector3d& mirror_translation = sensor.cache().camera_from_mirror_translation;
   std::vector<double> radii_mm;
   for (int k = 0; k < kCirclePoints; ++k) {
     const double angle = 2.0 * M_PI * k / kCirclePoints;
@@ -191,7 +189,7 @@ std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& 
     Eigen::Vector3d origin, direction;  // origin: the reflection point
     const ProjectionStatus status = wide.Unproject(pixel, &origin, &direction);
     if (status == ProjectionStatus::kOk)
-      radii_mm.push_back((mirror_rotation.transpose() * (origin - mirror_translation)).head<2>().norm());
+      radii_mm.push_back(sensor.cache().InMirrorFrame(origin).head<2>().norm());
     else if (status == ProjectionStatus::kOutsideMirror || status == ProjectionStatus::kMissesMirror)
       radii_mm.push_back(HUGE_VAL);  // beyond what `wide` sees: counted, or the median would lean inwards
   }

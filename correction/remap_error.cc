@@ -33,9 +33,8 @@ bool RemapDisplacementPx(const Sensor& sensor, const RemapSettings& settings, co
     return false;
   Eigen::Vector3d origin_in_camera, ray_in_camera;
   if (sensor.Unproject(omni_pixel, &origin_in_camera, &ray_in_camera) != ProjectionStatus::kOk) return false;
-  const Eigen::Matrix3d& mirror_from_camera = cache.camera_from_mirror_rotation.transpose();
-  const Eigen::Vector3d origin = mirror_from_camera * (origin_in_camera - cache.camera_from_mirror_translation);
-  const Eigen::Vector3d ray = (mirror_from_camera * ray_in_camera).normalized();
+  const Eigen::Vector3d origin = cache.InMirrorFrame(origin_in_camera);
+  const Eigen::Vector3d ray = (cache.camera_from_mirror_rotation.transpose() * ray_in_camera).normalized();
   if (!settings.surface.IntersectRay(viewpoint, origin, ray, far_mm, &shown_point)) return false;
   if (!settings.screen.PixelOf(shown_point - viewpoint, &shown_pixel)) return false;
   Eigen::Vector2d offset = shown_pixel - Eigen::Vector2d(col, row);

@@ -36,6 +36,11 @@ struct ProjectionCache {
   Eigen::Matrix3d camera_from_mirror_rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d camera_from_mirror_translation = Eigen::Vector3d::Zero();
   AxialGuessTable guess;
+
+  // A camera-frame point (mm) in the mirror's frame (its axis z).
+  Eigen::Vector3d InMirrorFrame(const Eigen::Vector3d& point_in_camera_mm) const {
+    return camera_from_mirror_rotation.transpose() * (point_in_camera_mm - camera_from_mirror_translation);
+  }
 };
 
 // A solved reflection point kept by a caller that projects the same point through the
