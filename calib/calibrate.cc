@@ -129,16 +129,27 @@ UsableViews SplitOff(UsableViews* views, const std::set<std::string>& names) {
   return held;
 }
 
-// The views `holdout` asks to keep out: spread evenly over the usable views, leaving >= 3.
-std::set<std::string> HoldoutNames(const CalibrationInput& input, const UsableViews& views, int holdout) {
+// The views to keep out: those named, or `holdout` spread evenly over the usable views;
+// leaving >= 3.
+std::set<std::string> HoldoutNames(const CalibrationInput& input, const UsableViews& views, int holdout,
+                                   const std::set<std::string>& named) {
   std::set<std::string> names;
-  if (holdout <= 0) return names;
   const size_t total = views.detections.images.size();
-  if (total < static_cast<size_t>(holdout) + 3)
+  const size_t asked = named.empty() ? static_cast<size_t>(std::max(holdout, 0)) : named.size();
+  if (asked > 0 && total < asked + 3)
     throw InputError(InputMessage(input.source, "holdout",
-                                  std::to_string(holdout) + " views held out of " + std::to_string(total) +
+                                  std::to_string(asked) + " views held out of " + std::to_string(total) +
                                       " usable leave fewer than 3 for the fit"));
-  for (size_t v : EvenlySpreadIndices(total, static_cast<size_t>(holdout))) names.insert(views.detections.images[v].image);
+  if (!named.empty()) {
+    for (const std::string& name : named) {
+      const bool usable = std::any_of(views.detections.images.begin(), views.detections.images.end(),
+                                      [&](const ImageDetections& image) { return image.image == name; });
+      if (!usable) throw InputError(InputMessage(input.source, "holdout", name + ": not a usable view"));
+    }
+    names = named;
+  } else if (holdout > 0) {
+    for (size_t v : EvenlySpreadIndices(total, static_cast<size_t>(holdout))) names.insert(views.detections.images[v].image);
+  }
   return names;
 }
 
@@ -207,7 +218,8 @@ DetectionSet CornersRefinedThrough(const CalibrationInput& input, const Calibrat
   DetectionOptions detection;
   detection.guess = through;
   detection.board_warp = warp;
-  detection.checkerboard_edges = options.checkerboard_edges;
+  detection.checkerboard_edges = options.checkerboard_edges.value_or(true) &&
+                                 input.target.type() == CalibrationTarget::Type::kCheckerboard;
   detection.threads = options.threads;
   detection.progress = options.progress;
   std::map<std::string, const cv::Mat*> in_memory;
@@ -303,6 +315,11 @@ std::string CalibrationOptions::Check() const {
   if (!(max_predicted_error_px >= 0.0 && std::isfinite(max_predicted_error_px))) return "max_predicted_error_px: must be >= 0";
   if (!(predicted_error_step_px > 0.0 && std::isfinite(predicted_error_step_px))) return "predicted_error_step_px: must be > 0";
   if (holdout_views < 0) return "holdout_views: must be >= 0";
+  if (holdout_folds < 0) return "holdout_folds: must be >= 0";
+  if (holdout_folds > 0 && (holdout_views > 0 || !holdout_images.empty()))
+    return "holdout_folds/holdout_views: each fold keeps its own views out: give one of them";
+  if (holdout_views > 0 && !holdout_images.empty())
+    return "holdout_views/holdout_images: give the count or the names, not both";
   if (knots != 0 && knots != kChooseKnots && (knots < SplineProfile<double>::kMinKnots || knots > SplineProfile<double>::kMaxKnots))
     return "knots: must be 4..16 (or auto)";
   if (cross_validation_distance_mm != 0.0)
@@ -311,21 +328,94 @@ std::string CalibrationOptions::Check() const {
   return "";
 }
 
+namespace {
+
+// CalibrationOptions::holdout_folds: the full set's calibration, then one per fold with
+// that fold's views kept out (detected and fitted without them, as `holdout_views`).
+CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const CalibrationOptions& options) {
+  CalibrationOptions full_options = options;
+  full_options.holdout_folds = 0;
+  CalibrationResult result = Calibrate(input, full_options);
+  std::vector<std::string> usable;  // the fitted views, in the input's order
+  for (size_t v = 0; v < result.views.images.size(); ++v)
+    if (v >= result.fit.view_left_out.size() || result.fit.view_left_out[v].empty())
+      usable.push_back(result.views.images[v].image);
+  const size_t per_fold = static_cast<size_t>(options.holdout_folds);
+  if (usable.size() < per_fold + 3)
+    throw InputError(InputMessage(input.source, "holdout_folds",
+                                  std::to_string(per_fold) + " views held out of " + std::to_string(usable.size()) +
+                                      " usable leave fewer than 3 for the fit"));
+  const size_t fold_count = (usable.size() + per_fold - 1) / per_fold;
+  CalibrationOptions fold_options = full_options;
+  fold_options.cross_validate = false;  // each fold answers one question: how well it predicts its views
+  fold_options.leave_one_out = false;
+  const auto warn = [&](CalibrationWarning warning) {
+    result.record.warnings.push_back(warning.text);
+    result.warnings.push_back(std::move(warning));
+  };
+  HeldOutFolds folds;
+  folds.views_per_fold = options.holdout_folds;
+  double held_square_px2 = 0.0, training_square_px2 = 0.0;
+  ProgressReporter progress(options.progress, "holdout folds", static_cast<long>(fold_count));
+  for (size_t f = 0; f < fold_count; ++f) {
+    fold_options.holdout_images.clear();
+    for (size_t v = f; v < usable.size(); v += fold_count) fold_options.holdout_images.insert(usable[v]);
+    const CalibrationRecord record = Calibrate(input, fold_options).record;
+    const HeldOutViews& held = *record.holdout;
+    HeldOutFolds::Fold fold;
+    fold.images = held.images;
+    fold.rms_px = held.rms_px;
+    fold.corners = held.corners;
+    fold.training_rms_px = record.rms_all_px;
+    fold.training_corners = record.observations;
+    folds.folds.push_back(fold);
+    for (const auto& [image, rms] : held.per_view_rms_px) folds.per_view_rms_px[image] = rms;
+    for (const auto& [image, why] : held.not_evaluated)
+      warn({WarningCode::kViewLeftOut, image, image + ": held-out view not evaluated: " + why});
+    if (std::isfinite(fold.rms_px) && fold.corners > 0) {
+      held_square_px2 += fold.corners * fold.rms_px * fold.rms_px;
+      folds.corners += fold.corners;
+    }
+    if (std::isfinite(fold.training_rms_px) && fold.training_corners > 0) {
+      training_square_px2 += fold.training_corners * fold.training_rms_px * fold.training_rms_px;
+      folds.training_corners += fold.training_corners;
+    }
+    progress.Step();
+  }
+  if (folds.corners > 0) folds.rms_px = std::sqrt(held_square_px2 / folds.corners);
+  if (folds.training_corners > 0) folds.training_rms_px = std::sqrt(training_square_px2 / folds.training_corners);
+  // The same 25 % as one held-out split's warning (below), on every view.
+  if (folds.rms_px > 1.25 * folds.training_rms_px) {
+    char text[300];
+    std::snprintf(text, sizeof text,
+                  "every view held out once (%zu folds): %.3f px RMS against %.3f px for the training views: the "
+                  "model does not predict new views as well as it fits its own (too flexible, or too few views)",
+                  folds.folds.size(), folds.rms_px, folds.training_rms_px);
+    warn({WarningCode::kHeldOutWorse, "", text});
+  }
+  result.record.holdout_folds = folds;
+  return result;
+}
+
+}  // namespace
+
 CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOptions& options) {
   if (const std::string why = options.Check(); !why.empty()) throw InputError(why);
+  if (options.holdout_folds > 0) return CalibrateWithHeldOutFolds(input, options);
   const int sources = !input.image_paths.empty() + !input.images.empty() + input.detections.has_value();
   if (sources != 1) throw InputError("images: give either images (detected here) or detections");
   const bool from_images = !input.detections;
-  // Said, not ignored: edge refinement and the predicted corners are steps of the second
-  // detection pass over a checkerboard's images.
-  if (options.checkerboard_edges && !from_images)
-    throw InputError("checkerboard_edges: refines the corners found in images, not corners given as detections "
-                     "(detect --sensor ... --checkerboard-edges refines them there)");
-  if (options.checkerboard_edges && input.target.type() != CalibrationTarget::Type::kCheckerboard)
+  // Said, not ignored: how a checkerboard's corners are refined is a step of the second
+  // detection pass over its images (unset: edges wherever that applies).
+  const bool refinement_asked = options.checkerboard_edges.has_value();
+  if (refinement_asked && !from_images)
+    throw InputError("checkerboard_edges: chooses how the corners found in images are refined, not corners given as "
+                     "detections (detect --sensor ... --checkerboard-edges refines them there)");
+  if (refinement_asked && input.target.type() != CalibrationTarget::Type::kCheckerboard)
     throw InputError("checkerboard_edges: the target is not a checkerboard");
-  if (options.checkerboard_edges && options.detection_passes < 2)
-    throw InputError("checkerboard_edges/detection_passes: the corners are refined by their edges in the second "
-                     "detection pass: give 2 or more");
+  if (refinement_asked && options.detection_passes < 2)
+    throw InputError("checkerboard_edges/detection_passes: the corners are refined in the second detection pass: "
+                     "give 2 or more");
   std::vector<CalibrationWarning> warnings;
   CalibrationRecord record;
   std::vector<PredictedError> predicted;
@@ -392,7 +482,7 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
 
   int unrefined = 0;
   UsableViews views = ViewsForFit(guess, input, FittableCorners(input, detections, &unrefined), &warnings);
-  const std::set<std::string> holdout_names = HoldoutNames(input, views, options.holdout_views);
+  const std::set<std::string> holdout_names = HoldoutNames(input, views, options.holdout_views, options.holdout_images);
   UsableViews held = SplitOff(&views, holdout_names);
   // Too few views to halve: said before the fit, not after it (the halves are of the views
   // the fit keeps, so this is necessary, and CrossValidateHalves checks again).

@@ -56,14 +56,26 @@ struct CalibrationOptions {
   // halves, each calibrated, compared at cross_validation_distance_mm (0: the first of
   // distances_mm / distances_n, else 2 m).
   int holdout_views = 0;
+  // The views to keep out by name instead (each a usable view); the folds below set it.
+  std::set<std::string> holdout_images;
+  // Every view held out once, K = holdout_folds at a time: after the full set's calibration
+  // (the one written), F = ceil(N / K) more over the N usable views, fold f keeping out views
+  // f, f + F, f + 2F, ... of them; record.holdout_folds pools them. One split of a few views
+  // is too few to judge by: on the real dev set the five splits of two views had held-out /
+  // training ratios of 0.83-1.42, pooled 1.09 (docs/calibrate.md). Not with holdout_views.
+  int holdout_folds = 0;
   // Fit the board's out-of-plane warp (calib/board_warp.h) with the sensor.
   bool board_warp = false;
   // Weight each view's corners by its own noise (FitOptions::view_noise_weights).
   bool view_weights = false;
-  // Refine checkerboard corners by their edges through the first fit, every one
-  // (CheckerRefinement::kEdges, calib/refine_corners.h), not by cornerSubPix on grid steps
-  // of 20 px and more.
-  bool checkerboard_edges = false;
+  // How a checkerboard's corners are refined through the first fit (second detection pass).
+  // Unset: by their edges, every one (CheckerRefinement::kEdges, calib/refine_corners.h),
+  // wherever that applies (a checkerboard's images, two passes or more). Set, it is refused
+  // where it cannot apply. true: by the edges. false: cornerSubPix on grid steps of 20 px and more,
+  // OpenCV's corners on the rest (the default before: those sat 0.02-0.11 px inwards per
+  // view on the realistic renders and put parameters beyond 3 std on 6 of 6 re-rendered
+  // seeds; docs/calibrate.md, "Checkerboard corners by their edges").
+  std::optional<bool> checkerboard_edges;
   // A spline mirror's knot count (model/spline_profile.h): 0 keeps the guess's (6 when
   // converted), 4..16, or kChooseKnots: chosen by held-out folds (calib/knot_choice.h).
   int knots = 0;

@@ -22,6 +22,11 @@ const char* const kPredictedErrorDefinition =
 const char* const kHoldoutDefinition =
     "views kept out of the fit (spread evenly over the input), their poses fitted with the sensor held; rms_px over "
     "all their corners, per corner sqrt(mean |e|^2); compare with training_rms_px (the fitted views, all corners)";
+const char* const kHoldoutFoldsDefinition =
+    "every usable view held out once, views_per_fold at a time: per fold a calibration without its views (detected and "
+    "fitted without them; fold f of F keeps out the usable views f, f + F, ... in the input's order), their poses "
+    "fitted with that sensor held; rms_px over every fold's held-out corners, training_rms_px over every fold's "
+    "fitted corners, both all corners, per corner sqrt(mean |e|^2); the written sensor is the full set's fit";
 const char* const kBoardWarpDefinition =
     "the board's out-of-plane shape z = x_mm (1 - u^2) + y_mm (1 - v^2) along its normal, u, v the corner's position "
     "scaled to [-1, 1] over the board's corners: the deflections at the centre relative to the edges (mm)";
@@ -103,6 +108,23 @@ json ToJson(const CalibrationRecord& r) {
     out["training_rms_px"] = NumberOrNull(r.rms_all_px);
     out["training_inlier_rms_px"] = r.rms_px;
     out["definition"] = kHoldoutDefinition;
+  }
+  if (const auto& h = r.holdout_folds) {
+    json& out = j["holdout_folds"];
+    out["views_per_fold"] = h->views_per_fold;
+    out["folds"] = json::array();
+    for (const HeldOutFolds::Fold& fold : h->folds)
+      out["folds"].push_back({{"views", fold.images},
+                              {"rms_px", NumberOrNull(fold.rms_px)},
+                              {"corners", fold.corners},
+                              {"training_rms_px", NumberOrNull(fold.training_rms_px)},
+                              {"training_corners", fold.training_corners}});
+    for (const auto& [image, rms] : h->per_view_rms_px) out["per_view_rms_px"][image] = NumberOrNull(rms);
+    out["rms_px"] = NumberOrNull(h->rms_px);
+    out["corners"] = h->corners;
+    out["training_rms_px"] = NumberOrNull(h->training_rms_px);
+    out["training_corners"] = h->training_corners;
+    out["definition"] = kHoldoutFoldsDefinition;
   }
   if (const auto& c = r.cross_validation) {
     json& out = j["cross_validation"];
@@ -221,6 +243,27 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
         for (const auto& [image, rms] : h.at("per_view_rms_px").items()) held.per_view_rms_px[image] = NumberOrNan(rms);
       if (h.contains("not_evaluated")) held.not_evaluated = h.at("not_evaluated").get<std::map<std::string, std::string>>();
       r.holdout = held;
+    }
+    if (j.contains("holdout_folds")) {
+      const json& h = at("holdout_folds");
+      HeldOutFolds folds;
+      folds.views_per_fold = h.at("views_per_fold").get<int>();
+      for (const json& f : h.at("folds")) {
+        HeldOutFolds::Fold fold;
+        fold.images = f.at("views").get<std::vector<std::string>>();
+        fold.rms_px = NumberOrNan(f.at("rms_px"));
+        fold.corners = f.at("corners").get<int>();
+        fold.training_rms_px = NumberOrNan(f.at("training_rms_px"));
+        fold.training_corners = f.at("training_corners").get<int>();
+        folds.folds.push_back(fold);
+      }
+      if (h.contains("per_view_rms_px"))
+        for (const auto& [image, rms] : h.at("per_view_rms_px").items()) folds.per_view_rms_px[image] = NumberOrNan(rms);
+      folds.rms_px = NumberOrNan(h.at("rms_px"));
+      folds.corners = h.at("corners").get<int>();
+      folds.training_rms_px = NumberOrNan(h.at("training_rms_px"));
+      folds.training_corners = h.at("training_corners").get<int>();
+      r.holdout_folds = folds;
     }
     if (j.contains("cross_validation")) {
       const json& c = at("cross_validation");

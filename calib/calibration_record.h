@@ -43,6 +43,7 @@ struct CalibrationRecord {
   // Views kept out of the fit and evaluated with the sensor held (CalibrationOptions::
   // holdout_views); the training RMS to compare with is rms_all_px / rms_px.
   std::optional<HeldOutViews> holdout;
+  std::optional<HeldOutFolds> holdout_folds;  // every view held out once (CalibrationOptions::holdout_folds)
   std::optional<BoardWarpEstimate> board_warp;  // when fitted (CalibrationOptions::board_warp)
   std::optional<KnotChoice> knot_choice;  // when chosen (CalibrationOptions::knots = kChooseKnots)
   // The two halves' calibrations compared (CalibrationOptions::cross_validate). The diff's

@@ -59,6 +59,12 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
   if (const auto& held = record.holdout)
     AppendFormatted(out, "held out: %zu views, %d corners: RMS %.4f px (training %.4f px, ratio %.2f)\n",
                     held->images.size(), held->corners, held->rms_px, record.rms_all_px, held->rms_px / record.rms_all_px);
+  if (const auto& folds = record.holdout_folds)
+    AppendFormatted(out,
+                    "every view held out once (%zu folds of %d): %d corners, RMS %.4f px (training %.4f px, ratio "
+                    "%.2f)\n",
+                    folds->folds.size(), folds->views_per_fold, folds->corners, folds->rms_px, folds->training_rms_px,
+                    folds->rms_px / folds->training_rms_px);
   if (const auto& cross = record.cross_validation)
     AppendFormatted(out,
                     "two halves (RMS %.4f / %.4f px) differ at %.0f mm by %.4f px RMS, %.4f px max over %d field "

@@ -40,6 +40,24 @@ struct HeldOutViews {
   int corners = 0, outliers = 0;
 };
 
+// Every view held out once (CalibrationOptions::holdout_folds): one calibration per fold,
+// each with the fold's views kept out, evaluated as HeldOutViews; pooled over the folds.
+struct HeldOutFolds {
+  struct Fold {
+    std::vector<std::string> images;  // held out
+    double rms_px = NAN;              // their corners, all
+    int corners = 0;
+    double training_rms_px = NAN;     // the fold's fitted views, all corners
+    int training_corners = 0;
+  };
+  int views_per_fold = 0;
+  std::vector<Fold> folds;
+  std::map<std::string, double> per_view_rms_px;  // each view, when held out (NaN: no pose)
+  double rms_px = NAN;           // every fold's held-out corners
+  double training_rms_px = NAN;  // every fold's training corners
+  int corners = 0, training_corners = 0;
+};
+
 // The views' poses fitted with `sensor` held (robust loss and outlier rule as in
 // `options`; every view kept however it fits: a held-out view is a measurement, not a
 // suspect). The board's warp is held at options.board_warp (the training fit's).

@@ -28,13 +28,16 @@
 // Measured (tests/bench/detection_recall, docs/detection-recall.md): aprilgrid corners
 // 0.079-0.127 px RMS from virtual views -> 0.045-0.092 px refined in patches; raw
 // 0.19-0.40 -> 0.11-0.35 refined on the omni image. Checkerboards on renders 0.189 ->
-// 0.068 px. On the real Mei images (grid steps 8-36 px) refining every corner made the
-// fit's halves differ more (0.317 -> 0.347 px at 2 m); refining only corners whose grid
-// step in the omni image is kMinRefinedCheckerStepPx or more improved every figure
-// (`calibrate --board-warp`: all-corner RMS 0.352 -> 0.326 px, halves 0.317 -> 0.267 px,
-// held-out views' RMS 1.30 -> 1.15 x the training views'; docs/calibrate.md): the
-// default. On renders refining the small squares too is better (realistic checkerboard
-// through the true sensor: 0.120 -> 0.078 px RMS from the truth, docs/detection-recall.md).
+// 0.068 px. On the real Mei images (grid steps 8-36 px) refining every corner by
+// cornerSubPix made the fit's halves differ more (0.317 -> 0.347 px at 2 m); refining only
+// corners whose grid step in the omni image is kMinRefinedCheckerStepPx or more improved
+// every figure (`calibrate --board-warp`: all-corner RMS 0.352 -> 0.326 px, halves 0.317 ->
+// 0.267 px, held-out views' RMS 1.30 -> 1.15 x the training views'; docs/calibrate.md):
+// detect's default, and calibrate's `--checkerboard-subpixel`. calibrate refines every
+// checkerboard corner by its edges (kEdges) through its first fit: on the real images
+// all-corner RMS 0.326 -> 0.285 px and every view held out in turn 0.345 -> 0.310 px; on
+// the realistic renders' 6 re-rendered seeds no inward bias (CalibrationOptions::
+// checkerboard_edges).
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -14,6 +14,7 @@
 #include "model/io/atomic_write.h"
 #include "model/model_registry.h"
 #include "tools/commands.h"
+#include "tools/generalisation_flags.h"
 #include "tools/progress.h"
 #include "model/io/sensor_yaml.h"
 
@@ -22,6 +23,7 @@ namespace {
 
 struct CalibrateFlags {
   std::string target_path, detections_path, images, sensor_path, out_dir, fix, tolerance, knots;
+  bool checkerboard_edges = false, checkerboard_subpixel = false;  // library.checkerboard_edges: true, false, unset
   CalibrationOptions library;
 };
 
@@ -30,7 +32,7 @@ const FlagTable kFlags = {{"fixed", "--fix"}, {"robust_loss_px", "--loss-px"}, {
                           {"rim_field_deg", "--rim-field-deg"}, {"guess", "--sensor"}, {"threads", "--threads"},
                           {"detection_passes", "--detection-passes"}, {"distances_mm", "--distance-mm"},
                           {"distances_n", "--distance-n"}, {"max_predicted_error_px", "--max-predicted-error-px"},
-                          {"holdout_views", "--holdout"}, {"holdout", "--holdout"}, {"cross_validate", "--cross-validate"},
+                          {"holdout_views", "--holdout"}, {"holdout", "--holdout"}, {"holdout_folds", "--holdout-folds"}, {"cross_validate", "--cross-validate"},
                           {"cross_validation_distance_mm", "--cross-validate-distance-mm"}, {"knots", "--knots"},
                           {"checkerboard_edges", "--checkerboard-edges"}};
 
@@ -58,8 +60,12 @@ void RunCalibrate(CalibrateFlags options, const Context& context) {
     if (!block.empty()) library.fixed.insert(block);
   library.tolerances = ParseDesignTolerances(options.tolerance, "--tolerance");
   if (!options.knots.empty()) library.knots = ParseKnotCount(options.knots, "--knots");
+  if (options.checkerboard_edges) library.checkerboard_edges = true;
+  if (options.checkerboard_subpixel) library.checkerboard_edges = false;
   library.progress = TerminalProgress(context);
-  const CalibrationResult result = NamingFlags(kFlags, [&] { return Calibrate(input, library); });
+  FlagTable flags = kFlags;
+  if (options.checkerboard_subpixel) flags["checkerboard_edges"] = "--checkerboard-subpixel";
+  const CalibrationResult result = NamingFlags(flags, [&] { return Calibrate(input, library); });
 
   const std::filesystem::path dir(options.out_dir);
   CreateOutputDirectory(dir);
@@ -118,31 +124,24 @@ Command CalibrateCommand() {
             sub.add_option("--max-predicted-error-px", library.max_predicted_error_px,
                            "Warn when the predicted projection error anywhere in the observed field exceeds this")
                 ->check(CLI::Range(0.0, 1000.0))->capture_default_str();
-            sub.add_option("--holdout", library.holdout_views,
-                           "Keep K views (spread evenly) out of the fit and report their RMS with the sensor held "
-                           "(their poses fitted): how well the calibration predicts new views")
-                ->check(CLI::Range(0, 10000));
+            AddGeneralisationFlags(sub, &library);
             sub.add_flag("--board-warp", library.board_warp,
                          "Also fit the board's out-of-plane warp (a paraboloid along each board axis, mm at the centre; "
                          "paper boards bend)");
-            sub.add_flag("--checkerboard-edges", library.checkerboard_edges,
-                         "Refine checkerboard corners through the first fit by their edges (curves fitted across both "
-                         "sides of each junction), every corner, instead of cornerSubPix on squares of 20 px and more");
+            auto* edges = sub.add_flag("--checkerboard-edges", options->checkerboard_edges,
+                                       "Refine checkerboard corners through the first fit by their edges (curves fitted "
+                                       "across both sides of each junction), every corner: the default for a "
+                                       "checkerboard's images");
+            sub.add_flag("--checkerboard-subpixel", options->checkerboard_subpixel,
+                         "Refine checkerboard corners by cornerSubPix on squares of 20 px and more, OpenCV's on smaller "
+                         "(biased inwards near the rim); either flag is refused where it cannot apply")
+                ->excludes(edges);
             sub.add_flag("--view-weights", library.view_weights,
                          "Weight each view's corners by its own noise, estimated from its residuals (views as sharp "
                          "as they are noisy: blur and JPEG near the rim); calibration.json per_view_weight");
             sub.add_option("--knots", options->knots,
                            "With --profile spline: the mirror's knot count (4..16), or auto: chosen by held-out "
                            "folds of the views (calibration.json knot_choice)");
-            sub.add_flag("--cross-validate", library.cross_validate,
-                         "Also calibrate each half of the views (even / odd) and report how far the two disagree over "
-                         "the observed field after the best rigid alignment (report/cross_validation.png)");
-            sub.add_option("--cross-validate-distance-mm", library.cross_validation_distance_mm,
-                           "Distance of the cross-validation comparison (mm from the reflection point; default: the "
-                           "first --distance-mm / --distance-n, else 2000)")
-                ->check(kPositive);
-            sub.add_flag("--leave-one-out", library.leave_one_out,
-                         "Also fit without each image in turn; calibration.json gets each parameter's spread");
             return [options, &context]() { RunCalibrate(*options, context); };
           }};
 }

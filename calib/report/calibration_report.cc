@@ -112,31 +112,37 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
 
 // Per-view RMS over all corners: the fitted views, then the held-out ones, with the
 // training RMS as a line to compare with.
+// A view's RMS over all its corners with a residual (NaN: none), as the held-out RMS is
+// (outliers are a fit's notion; a held-out view has none).
+double AllCornerViewRms(const std::vector<Eigen::Vector2d>& residuals) {
+  double square = 0.0;
+  int count = 0;
+  for (const Eigen::Vector2d& e : residuals)
+    if (e.allFinite()) square += e.squaredNorm(), ++count;
+  return count > 0 ? std::sqrt(square / count) : NAN;
+}
+
+// A bar from left to right at height `rms`, appended to a series' outline.
+void AppendBar(double left, double right, double rms, std::vector<double>* x, std::vector<double>* y) {
+  x->insert(x->end(), {left, left, right, right});
+  y->insert(y->end(), {0.0, rms, rms, 0.0});
+}
+
 void WriteHoldoutFigure(const std::string& path, const CalibrationResult& result, const HeldOutViews& held) {
-  // Both kinds of bar over all of a view's corners, as the held-out RMS is (outliers are a
-  // fit's notion; a held-out view has none).
   PlotPanel panel("Per-view RMS over all corners: fitted views (left), held-out views (right)", "view", "RMS (px)");
   std::vector<double> x, y;
   double v = 0.0;
   for (const std::vector<Eigen::Vector2d>& residuals : result.fit.residuals_px) {
-    double square = 0.0;
-    int count = 0;
-    for (const Eigen::Vector2d& e : residuals)
-      if (e.allFinite()) square += e.squaredNorm(), ++count;
-    if (count == 0) continue;
-    const double rms = std::sqrt(square / count);
-    x.insert(x.end(), {v - 0.4, v - 0.4, v + 0.4, v + 0.4});
-    y.insert(y.end(), {0.0, rms, rms, 0.0});
+    const double rms = AllCornerViewRms(residuals);
+    if (!std::isfinite(rms)) continue;
+    AppendBar(v - 0.4, v + 0.4, rms, &x, &y);
     v += 1.0;
   }
   panel.series.push_back(PlotSeries("fitted", x, y, SeriesColor(0)));
   x.clear(), y.clear();
   for (const std::string& image : held.images) {
     const double rms = held.per_view_rms_px.count(image) ? held.per_view_rms_px.at(image) : NAN;
-    if (std::isfinite(rms)) {
-      x.insert(x.end(), {v - 0.4, v - 0.4, v + 0.4, v + 0.4});
-      y.insert(y.end(), {0.0, rms, rms, 0.0});
-    }
+    if (std::isfinite(rms)) AppendBar(v - 0.4, v + 0.4, rms, &x, &y);
     v += 1.0;
   }
   panel.series.push_back(PlotSeries("held out", x, y, SeriesColor(1)));
@@ -146,6 +152,27 @@ void WriteHoldoutFigure(const std::string& path, const CalibrationResult& result
   PlotSeries training(label, {-0.5, v - 0.5}, {training_rms_px, training_rms_px}, SeriesColor(2));
   training.dashed = true;
   panel.series.push_back(training);
+  WritePng(path, RenderPanel(panel, 800, 500));
+}
+
+// Each fitted view twice: its RMS in the full set's fit and when its fold held it out.
+void WriteHoldoutFoldsFigure(const std::string& path, const CalibrationResult& result, const HeldOutFolds& folds) {
+  char title[200];
+  std::snprintf(title, sizeof title, "Every view held out once: %.3f px RMS, training %.3f px (all corners)",
+                folds.rms_px, folds.training_rms_px);
+  PlotPanel panel(title, "view", "RMS (px)");
+  std::vector<double> fitted_x, fitted_y, held_x, held_y;
+  double v = 0.0;
+  for (size_t i = 0; i < result.fit.residuals_px.size() && i < result.views.images.size(); ++i) {
+    const double rms = AllCornerViewRms(result.fit.residuals_px[i]);
+    const auto held = folds.per_view_rms_px.find(result.views.images[i].image);
+    if (!std::isfinite(rms) || held == folds.per_view_rms_px.end()) continue;
+    AppendBar(v - 0.4, v, rms, &fitted_x, &fitted_y);
+    if (std::isfinite(held->second)) AppendBar(v, v + 0.4, held->second, &held_x, &held_y);
+    v += 1.0;
+  }
+  panel.series.push_back(PlotSeries("in the full fit", fitted_x, fitted_y, SeriesColor(0)));
+  panel.series.push_back(PlotSeries("held out", held_x, held_y, SeriesColor(1)));
   WritePng(path, RenderPanel(panel, 800, 500));
 }
 
@@ -159,6 +186,8 @@ void WriteCalibrationReport(const std::string& dir, const CalibrationResult& res
     WriteProjectionDiffFigure((path / "cross_validation.png").string(), cross->diff, result.sensor.image_width_px(),
                               result.sensor.image_height_px(), "two halves of the views, each calibrated: half 2 against half 1");
   if (const auto& held = result.record.holdout) WriteHoldoutFigure((path / "holdout.png").string(), result, *held);
+  if (const auto& folds = result.record.holdout_folds)
+    WriteHoldoutFoldsFigure((path / "holdout_folds.png").string(), result, *folds);
   for (size_t k = 0; k < result.predicted.size(); ++k)
     WritePredictedErrorMap((path / ("predicted_error_" + std::to_string(k) + ".png")).string(), result.sensor,
                            result.predicted[k], options.predicted_error_step_px, options.max_predicted_error_px,

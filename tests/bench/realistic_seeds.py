@@ -3,7 +3,7 @@
 weighting option, scored against the truth (writes docs/realistic-seeds.md).
 
 The bundled realistic sets are one draw each: one set of random board poses, one noise.
-Whether an option (--checkerboard-edges, --view-weights, --detection-passes 3) helps, and whether the reported
+Whether an option (--checkerboard-subpixel, --view-weights, --detection-passes 3) helps, and whether the reported
 std are honest, only shows over several draws. For each seed k the scene
 datasets-synthetic/scenes/realistic-<kind>.yaml is rendered with its noise seed and its
 random-pose seed both moved by k (the four fixed rim and inner-radius views stay), then
@@ -36,7 +36,7 @@ import sphere_truth  # noqa: E402
 data_dir = os.path.join(source_dir, "datasets-synthetic")
 targets = {"checkerboard": "checkerboard-8x6-30mm.yaml", "aprilgrid": "aprilgrid-6x6-30mm.yaml"}
 option_sets = {
-    "checkerboard": [[], ["--checkerboard-edges"], ["--view-weights"], ["--checkerboard-edges", "--view-weights"]],
+    "checkerboard": [[], ["--checkerboard-subpixel"], ["--view-weights"]],
     "aprilgrid": [[], ["--detection-passes", "3"], ["--view-weights"]],
 }
 parameter_names = ["fx_px", "fy_px", "cx_px", "cy_px", "k1", "k2", "A_mm", "decenter_x_mm", "decenter_y_mm", "m_mm"]

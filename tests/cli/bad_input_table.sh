@@ -151,6 +151,8 @@ row detect "--checkerboard-edges without --sensor" "$o.json" error -- detect --t
 row calibrate "--checkerboard-edges with an aprilgrid" "$o" error -- calibrate --target "$grid" --images "$f/strip" --sensor "$guess" --checkerboard-edges --out "$o"
 row calibrate "--checkerboard-edges with --detections" "$o" error -- calibrate --target "$data/targets/checkerboard-8x6-30mm.yaml" --detections "$f/detections-one.json" --sensor "$guess" --checkerboard-edges --out "$o"
 row calibrate "--checkerboard-edges with one detection pass" "$o" error -- calibrate --target "$data/targets/checkerboard-8x6-30mm.yaml" --images "$f/strip" --sensor "$guess" --checkerboard-edges --detection-passes 1 --out "$o"
+row calibrate "--checkerboard-edges with --checkerboard-subpixel" "$o" error -- calibrate --target "$data/targets/checkerboard-8x6-30mm.yaml" --images "$f/strip" --sensor "$guess" --checkerboard-edges --checkerboard-subpixel --out "$o"
+row calibrate "--checkerboard-subpixel with an aprilgrid" "$o" error -- calibrate --target "$grid" --images "$f/strip" --sensor "$guess" --checkerboard-subpixel --out "$o"
 row calibrate "one truncated image" "$o" error -- calibrate --target "$grid" --images "$f/truncated" --sensor "$guess" --out "$o"
 row calibrate "huge corner coordinate" "$o" error -- calibrate --target "$grid" --detections "$f/detections-huge.json" --sensor "$guess" --out "$o"
 row calibrate "corners found on another board" "$o" error -- calibrate --target "$grid" --detections "$f/detections-other-board.json" --sensor "$guess" --out "$o"

@@ -8,7 +8,8 @@
 # sphere_truth.py), no view left out. Measured: aprilgrid within 1.4 std (A; 1.2 before rim
 # corners were kept by the rim their tag's fit placed, 1.7 before each
 # complete tag was fitted whole, calib/tag_template_fit.h), checkerboard
-# within 1.7 std (2.2 before its rim junctions were predicted and fitted whole; fx, m and k2 4.7-4.8 std off before calib/checkerboard_candidates.h's
+# within 2.2 std (k1; corners by their edges, the default; with cornerSubPix,
+# --checkerboard-subpixel, 1.6 std, 2.2 before its rim junctions were predicted and fitted whole; fx, m and k2 4.7-4.8 std off before calib/checkerboard_candidates.h's
 # junction check put real001's sheared corners back on their junctions; fx, k2 and
 # decenter_x 3.2-4.8 std off when the corners were refined through the design guess
 # instead of the first fit; inner1, the bent board at the inner radius, was refused as
@@ -26,17 +27,13 @@
 # across it (floor 8; worst 0.156 px, bound 0.2). Checkerboard: the corners a fitted board lacks are predicted through the first
 # fit and kept where a junction is found there (calib/checkerboard_completion.h: by the edge
 # profiles where they are clear of the rim, else by its squares fitted whole with the rim
-# modelled, calib/checker_junction_fit.h); found 570 of 570, 13 of them predicted, used 567
-# (99.5 %; 3 cut), within 0.3 px (0.116); every parameter within 1.6 std (k2).
-# Predicted corners confirmed: 0.01-0.23 px from the truth, the worst a junction 0.75 px
+# modelled, calib/checker_junction_fit.h); found 570 of 570, 13 of them predicted, used 570
+# (100 %; 0 cut; 567 and 3 cut with cornerSubPix), refined corners 0.041 px RMS from the
+# truth (0.063 before the edges were kept clear of the rim; 0.116 with cornerSubPix):
+# bounded at 0.06 px. Predicted corners confirmed: 0.01-0.23 px from the truth, the worst a junction 0.75 px
 # inside the rim, bounded at 0.25 px (edge profiles read the black beyond the rim as ink: a
 # junction 4.5 px inside it went 2.6 px off until they were kept clear of it).
-# checkerboard-edges: the checkerboard set with --checkerboard-edges (every corner refined by
-# its edges through the first fit, calib/refine_corners.h): every parameter within 2.5
-# std (k1; runs with 2 threads vary by a few tenths), found and used 570 of 570, refined
-# corners 0.041 px RMS from the truth (0.063 before the edges were kept clear of the rim;
-# 0.116 without): bounded at 0.06 px.
-# Usage: realistic_render_test.sh OMNICAL_BINARY SOURCE_DIR [aprilgrid|checkerboard|checkerboard-edges]
+# Usage: realistic_render_test.sh OMNICAL_BINARY SOURCE_DIR [aprilgrid|checkerboard]
 set -u
 omnical=$1
 source_dir=$(cd "$2" && pwd)
@@ -44,19 +41,18 @@ kind=${3:-aprilgrid}
 data=$source_dir/datasets-synthetic
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-extra=() corner_bound=0.3 predicted_floor=0 predicted_bound=0.25
+corner_bound=0.3 predicted_floor=0 predicted_bound=0.25
 case $kind in
   aprilgrid) target=$data/targets/aprilgrid-6x6-30mm.yaml found_floor=0.99 used_floor=0.99 corner_bound=0.1 predicted_floor=8
     predicted_bound=0.2 ;;
-  checkerboard) target=$data/targets/checkerboard-8x6-30mm.yaml found_floor=0.99 used_floor=0.99 predicted_floor=10 ;;
-  checkerboard-edges) target=$data/targets/checkerboard-8x6-30mm.yaml found_floor=0.99 used_floor=0.99
-    kind=checkerboard extra=(--checkerboard-edges) corner_bound=0.06 predicted_floor=10 ;;
+  checkerboard) target=$data/targets/checkerboard-8x6-30mm.yaml found_floor=0.99 used_floor=0.99 corner_bound=0.06
+    predicted_floor=10 ;;
   *) echo "FAIL: unknown set kind '$kind'"; exit 1 ;;
 esac
 set_dir=$data/rendered/realistic-$kind
 
 "$omnical" -q calibrate --target "$target" --images "$set_dir" \
-  --sensor "$data/sensors/ohte-sph-misaligned-guess.yaml" --board-warp --threads 2 "${extra[@]}" --out "$work/cal" 2>/dev/null ||
+  --sensor "$data/sensors/ohte-sph-misaligned-guess.yaml" --board-warp --threads 2 --out "$work/cal" 2>/dev/null ||
   { echo "FAIL: calibrate exited $?"; exit 1; }
 
 OMNICAL_CLI_TESTS=$source_dir/tests/cli python3 - "$set_dir" "$work/cal" "$found_floor" "$used_floor" "$corner_bound" "$predicted_floor" "$predicted_bound" <<'PY'

@@ -344,6 +344,40 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
         omnical.diff(result.sensor, result.sensor, field=3)
 
 
+def test_holdout_folds_equal_cli(runs, tmp_path):
+    """holdout_folds (--holdout-folds): every fitted view held out once, both front ends the
+    same numbers; the written calibration is the full set's."""
+    detections = runs.out / "cli" / "detections.json"
+    result, done = beside_cli(
+        ["-q", "calibrate", "--target", TARGET, "--detections", detections, "--sensor", GUESS, "--holdout-folds", 4,
+         "--out", tmp_path / "cli"],
+        lambda: omnical.calibrate(TARGET, detections=detections, guess=GUESS, holdout_folds=4))
+    assert done.returncode == 0, done.stderr
+    cli = json.loads((tmp_path / "cli" / "calibration.json").read_text())
+    assert_json_equal(json.loads(result.to_json()), cli)
+    folds = result.holdout_folds
+    held = [view for fold in folds["folds"] for view in fold["views"]]
+    assert sorted(held) == sorted(result.poses) and folds["views_per_fold"] == 4
+    assert all(len(fold["views"]) <= 4 for fold in folds["folds"])
+    # Pooled over the folds' corners: every fitted corner is held out once.
+    assert folds["corners"] == sum(fold["corners"] for fold in folds["folds"]) == result.observations
+    pooled = math.sqrt(sum(fold["corners"] * fold["rms_px"] ** 2 for fold in folds["folds"]) / folds["corners"])
+    assert close(folds["rms_px"], pooled)
+    plain = omnical.calibrate(TARGET, detections=detections, guess=GUESS)  # the full set's fit, as without folds
+    assert_json_equal(json.loads(result.to_json())["parameters"], json.loads(plain.to_json())["parameters"])
+    assert f"every view held out once ({len(folds['folds'])} folds of 4)" in result.summary()
+    assert (tmp_path / "cli" / "report" / "holdout_folds.png").stat().st_size > 0
+    loaded = omnical.load_calibration(tmp_path / "cli" / "calibration.json")
+    assert loaded.to_json() == (tmp_path / "cli" / "calibration.json").read_text()  # read back whole
+    assert loaded.holdout_folds["folds"][0]["views"] == folds["folds"][0]["views"]
+
+    both = cli_error(run_cli("calibrate", "--target", TARGET, "--detections", detections, "--sensor", GUESS,
+                             "--holdout", 2, "--holdout-folds", 2, "--out", tmp_path / "bad"))
+    assert both.startswith("--holdout-folds/--holdout: each fold keeps its own views out")
+    with pytest.raises(omnical.InputError, match="^holdout_folds/holdout_views: each fold keeps its own views out"):
+        omnical.calibrate(TARGET, detections=detections, guess=GUESS, holdout=2, holdout_folds=2)
+
+
 def test_view_weights_equal_cli(runs, tmp_path):
     """view_weights (--view-weights): both front ends, the same weights, one per fitted view,
     each the pooled noise over the view's own (so weight x the view's RMS is nearly the same for
@@ -423,6 +457,27 @@ def test_detect_refine_options_equal_cli(tmp_path):
         found.save(directory / "py.json")
         assert_json_equal(json.loads((directory / "py.json").read_text()), json.loads((directory / "cli.json").read_text()))
         assert len(found.images[0]) > 0
+
+
+def test_calibrate_checkerboard_refinement_equals_cli(tmp_path):
+    """checkerboard_edges: None (the default, every corner by its edges through the first
+    fit) and False (--checkerboard-subpixel: cornerSubPix) give the CLI's detections, and
+    the two refine the corners differently."""
+    boards = DATA / "rendered" / "ohte-sph-checkerboard-near"
+    found = {}
+    for name, kwargs, flags in [("edges", {}, []), ("subpixel", {"checkerboard_edges": False}, ["--checkerboard-subpixel"])]:
+        result, done = beside_cli(
+            ["-q", "calibrate", "--target", CHECKERBOARD, "--images", boards, "--sensor", boards / "sensor.yaml",
+             "--threads", 1, *flags, "--out", tmp_path / name],
+            lambda: omnical.calibrate(str(CHECKERBOARD), str(boards), guess=str(boards / "sensor.yaml"), threads=1,
+                                      **kwargs))
+        assert done.returncode == 0, done.stderr
+        result.save(tmp_path / (name + "-py"))
+        cli = json.loads((tmp_path / name / "detections.json").read_text())
+        assert_json_equal(json.loads((tmp_path / (name + "-py") / "detections.json").read_text()), cli)
+        found[name] = {(image["image"], corner["id"]): corner["pixel"] for image in cli["images"] for corner in image["corners"]}
+    moved = [key for key in found["edges"] if key in found["subpixel"] and found["edges"][key] != found["subpixel"][key]]
+    assert len(moved) > len(found["edges"]) // 2
 
 
 def test_detections_round_trip(few, tmp_path):

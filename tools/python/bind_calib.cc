@@ -270,6 +270,22 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
       "The held-out views (holdout=K): dict views, rms_px (all their corners, sensor held, poses fitted), "
       "inlier_rms_px, corners, outliers, per_view_rms_px, not_evaluated, training_rms_px; None unless asked.");
   cls.def_property_readonly(
+      "holdout_folds",
+      [record](const Holder& holder) -> py::object {
+        const auto& h = record(holder).holdout_folds;
+        if (!h) return py::none();
+        py::list folds;
+        for (const HeldOutFolds::Fold& fold : h->folds)
+          folds.append(py::dict("views"_a = fold.images, "rms_px"_a = fold.rms_px, "corners"_a = fold.corners,
+                                "training_rms_px"_a = fold.training_rms_px, "training_corners"_a = fold.training_corners));
+        return py::dict("views_per_fold"_a = h->views_per_fold, "folds"_a = folds, "per_view_rms_px"_a = h->per_view_rms_px,
+                        "rms_px"_a = h->rms_px, "corners"_a = h->corners, "training_rms_px"_a = h->training_rms_px,
+                        "training_corners"_a = h->training_corners);
+      },
+      "Every view held out once (holdout_folds=K): dict views_per_fold, folds (per fold: views, rms_px, corners, "
+      "training_rms_px, training_corners), per_view_rms_px, rms_px (every fold's held-out corners), corners, "
+      "training_rms_px, training_corners; None unless asked.");
+  cls.def_property_readonly(
       "cross_validation",
       [record](const Holder& holder) -> py::object {
         const auto& c = record(holder).cross_validation;
@@ -358,8 +374,8 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
                         int max_iterations, int detection_passes, int threads, bool leave_one_out,
                         const py::object& tolerances, const std::vector<double>& distances_mm,
                         const std::vector<double>& distances_n, double max_predicted_error_px, double rim_field_deg,
-                        int holdout, bool cross_validate, double cross_validation_distance_mm, bool board_warp,
-                        bool view_weights, bool checkerboard_edges,
+                        int holdout, int holdout_folds, bool cross_validate, double cross_validation_distance_mm, bool board_warp,
+                        bool view_weights, std::optional<bool> checkerboard_edges,
                         const py::object& knots, py::object progress) {
   CalibrationInput input;
   PyTarget target = TargetOf(target_arg);
@@ -398,6 +414,7 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
   options.max_predicted_error_px = max_predicted_error_px;
   options.rim_field_deg = rim_field_deg;
   options.holdout_views = holdout;
+  options.holdout_folds = holdout_folds;
   options.board_warp = board_warp;
   options.view_weights = view_weights;
   options.checkerboard_edges = checkerboard_edges;
@@ -684,9 +701,9 @@ are also attributes here), the warnings with their codes, the views and residual
         "guess"_a = py::none(), "profile"_a = "", "fixed"_a = py::tuple(), "loss_px"_a = 1.0, "max_iterations"_a = 200,
         "detection_passes"_a = 2, "threads"_a = 0, "leave_one_out"_a = false, "tolerances"_a = py::none(),
         "distances_mm"_a = std::vector<double>(), "distances_n"_a = std::vector<double>(),
-        "max_predicted_error_px"_a = 0.3, "rim_field_deg"_a = kDefaultRimFieldDeg, "holdout"_a = 0,
-        "cross_validate"_a = false, "cross_validation_distance_mm"_a = 0.0, "board_warp"_a = false, "view_weights"_a = false, "checkerboard_edges"_a = false,
-        "knots"_a = 0, "progress"_a = py::none(),
+        "max_predicted_error_px"_a = 0.3, "rim_field_deg"_a = kDefaultRimFieldDeg, "holdout"_a = 0, "holdout_folds"_a = 0,
+        "cross_validate"_a = false, "cross_validation_distance_mm"_a = 0.0, "board_warp"_a = false, "view_weights"_a = false,
+        "checkerboard_edges"_a = py::none(), "knots"_a = 0, "progress"_a = py::none(),
         R"(Calibrates the sensor (as `omnical calibrate`) -> CalibrationResult.
 
 target: a Target or a spec path. Corners: images (as detect(): a directory or glob, a
@@ -702,13 +719,17 @@ first fit, 3 (aprilgrids) once more through the second. threads: detection, boar
 tolerances: design tolerances (dict name -> one std, or 'name=value,...').
 distances_mm / distances_n: where to predict the projection error (mm, or rim radii);
 max_predicted_error_px: warn above it. holdout: K views (spread evenly) kept out of the
-fit and evaluated with the sensor held (result.holdout). cross_validate: each half of the
+fit and evaluated with the sensor held (result.holdout). holdout_folds: every view held
+out once, K at a time, one calibration per fold (result.holdout_folds; the result is the
+full set's). cross_validate: each half of the
 views calibrated and compared at cross_validation_distance_mm (0: the first distance
 asked, else 2000) after the best rigid alignment (result.cross_validation). board_warp:
 also fit the board's out-of-plane warp (result.board_warp, mm). view_weights: weight
 each view's corners by its own noise, estimated from its residuals
-(result.per_view_weight). checkerboard_edges: refine checkerboard corners through the
-first fit by their edges, every one (--checkerboard-edges). knots: the spline
+(result.per_view_weight). checkerboard_edges: None (default) refines a checkerboard's
+corners through the first fit by their edges, every one, where that applies; True asks
+for it (--checkerboard-edges: refused where it cannot apply); False refines them by
+cornerSubPix on squares of 20 px and more instead (--checkerboard-subpixel). knots: the spline
 mirror's knot count (profile='spline'): 0 the guess's (6 converted), 4..16, or 'auto' to
 choose it by held-out folds (result.knot_choice).
 progress(stage, done, total): False cancels.

@@ -220,6 +220,8 @@ class CalibrationRecord:
     @property
     def holdout(self) -> Optional[Dict[str, object]]: ...
     @property
+    def holdout_folds(self) -> Optional[Dict[str, object]]: ...
+    @property
     def cross_validation(self) -> Optional[Dict[str, object]]: ...
     @property
     def predicted_error(self) -> List[Dict[str, float]]: ...
@@ -302,6 +304,8 @@ class CalibrationResult:
     @property
     def holdout(self) -> Optional[Dict[str, object]]: ...
     @property
+    def holdout_folds(self) -> Optional[Dict[str, object]]: ...
+    @property
     def cross_validation(self) -> Optional[Dict[str, object]]: ...
     @property
     def predicted_error(self) -> List[Dict[str, float]]: ...
@@ -329,8 +333,9 @@ def calibrate(target: Union[Target, _Path], images: Optional[_Images] = None, *,
               max_iterations: int = 200, detection_passes: int = 2, threads: int = 0, leave_one_out: bool = False,
               tolerances: Union[Mapping[str, float], str, None] = None, distances_mm: Sequence[float] = (),
               distances_n: Sequence[float] = (), max_predicted_error_px: float = 0.3, rim_field_deg: float = 105.0,
-              holdout: int = 0, cross_validate: bool = False, cross_validation_distance_mm: float = 0.0,
-              board_warp: bool = False, view_weights: bool = False, checkerboard_edges: bool = False,
+              holdout: int = 0, holdout_folds: int = 0, cross_validate: bool = False,
+              cross_validation_distance_mm: float = 0.0, board_warp: bool = False, view_weights: bool = False,
+              checkerboard_edges: Optional[bool] = None,
               knots: Union[int, str] = 0, progress: _Progress = None) -> CalibrationResult: ...
 
 def diff(a: Union[Sensor, _Path], b: Union[Sensor, _Path], *, distance_mm: float = 2000.0,

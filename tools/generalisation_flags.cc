@@ -1,0 +1,28 @@
+#include "tools/generalisation_flags.h"
+
+#include "tools/cli_common.h"
+
+namespace omnical::cli {
+
+void AddGeneralisationFlags(CLI::App& sub, CalibrationOptions* library) {
+  sub.add_option("--holdout", library->holdout_views,
+                 "Keep K views (spread evenly) out of the fit and report their RMS with the sensor held (their poses "
+                 "fitted): how well the calibration predicts new views")
+      ->check(CLI::Range(0, 10000));
+  sub.add_option("--holdout-folds", library->holdout_folds,
+                 "Hold every view out once, K at a time: one more calibration per fold, each fold's views evaluated "
+                 "with its sensor held; pooled in calibration.json holdout_folds (the written calibration is the full "
+                 "set's)")
+      ->check(CLI::Range(0, 10000));
+  sub.add_flag("--cross-validate", library->cross_validate,
+               "Also calibrate each half of the views (even / odd) and report how far the two disagree over the "
+               "observed field after the best rigid alignment (report/cross_validation.png)");
+  sub.add_option("--cross-validate-distance-mm", library->cross_validation_distance_mm,
+                 "Distance of the cross-validation comparison (mm from the reflection point; default: the first "
+                 "--distance-mm / --distance-n, else 2000)")
+      ->check(kPositive);
+  sub.add_flag("--leave-one-out", library->leave_one_out,
+               "Also fit without each image in turn; calibration.json gets each parameter's spread");
+}
+
+}  // namespace omnical::cli

@@ -1,0 +1,13 @@
+// calibrate's flags asking how well a calibration generalises (calib/cross_validation.h):
+// held-out views, every view held out in folds, two halves, leave-one-out.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include "calib/calibrate.h"
+
+namespace omnical::cli {
+
+void AddGeneralisationFlags(CLI::App& sub, CalibrationOptions* library);
+
+}  // namespace omnical::cli
