@@ -129,6 +129,20 @@ UsableViews SplitOff(UsableViews* views, const std::set<std::string>& names) {
   return held;
 }
 
+// Held-out views fitting over 25 % worse than the training views: more than the few-percent
+// spread of per-view RMS a well-posed fit shows between views of one set (the BabelCalib
+// protocol's usual reading). `which` names the held-out views and leads the text.
+void WarnIfHeldOutWorse(const std::string& which, double held_rms_px, double training_rms_px,
+                        std::vector<CalibrationWarning>* warnings) {
+  if (!(held_rms_px > 1.25 * training_rms_px)) return;
+  char text[300];
+  std::snprintf(text, sizeof text,
+                " %.3f px RMS against %.3f px for the training views: the model does not predict new views as well "
+                "as it fits its own (too flexible, or too few views)",
+                held_rms_px, training_rms_px);
+  warnings->push_back({WarningCode::kHeldOutWorse, "", which + text});
+}
+
 // The views to keep out: those named, or `holdout` spread evenly over the usable views;
 // leaving >= 3.
 std::set<std::string> HoldoutNames(const CalibrationInput& input, const UsableViews& views, int holdout,
@@ -349,10 +363,7 @@ CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const
   CalibrationOptions fold_options = full_options;
   fold_options.cross_validate = false;  // each fold answers one question: how well it predicts its views
   fold_options.leave_one_out = false;
-  const auto warn = [&](CalibrationWarning warning) {
-    result.record.warnings.push_back(warning.text);
-    result.warnings.push_back(std::move(warning));
-  };
+  std::vector<CalibrationWarning> warnings;  // the folds' own, added to the full set's below
   HeldOutFolds folds;
   folds.views_per_fold = options.holdout_folds;
   double held_square_px2 = 0.0, training_square_px2 = 0.0;
@@ -371,7 +382,7 @@ CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const
     folds.folds.push_back(fold);
     for (const auto& [image, rms] : held.per_view_rms_px) folds.per_view_rms_px[image] = rms;
     for (const auto& [image, why] : held.not_evaluated)
-      warn({WarningCode::kViewLeftOut, image, image + ": held-out view not evaluated: " + why});
+      warnings.push_back({WarningCode::kViewLeftOut, image, image + ": held-out view not evaluated: " + why});
     if (std::isfinite(fold.rms_px) && fold.corners > 0) {
       held_square_px2 += fold.corners * fold.rms_px * fold.rms_px;
       folds.corners += fold.corners;
@@ -384,14 +395,11 @@ CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const
   }
   if (folds.corners > 0) folds.rms_px = std::sqrt(held_square_px2 / folds.corners);
   if (folds.training_corners > 0) folds.training_rms_px = std::sqrt(training_square_px2 / folds.training_corners);
-  // The same 25 % as one held-out split's warning (below), on every view.
-  if (folds.rms_px > 1.25 * folds.training_rms_px) {
-    char text[300];
-    std::snprintf(text, sizeof text,
-                  "every view held out once (%zu folds): %.3f px RMS against %.3f px for the training views: the "
-                  "model does not predict new views as well as it fits its own (too flexible, or too few views)",
-                  folds.folds.size(), folds.rms_px, folds.training_rms_px);
-    warn({WarningCode::kHeldOutWorse, "", text});
+  WarnIfHeldOutWorse("every view held out once (" + std::to_string(folds.folds.size()) + " folds):", folds.rms_px,
+                     folds.training_rms_px, &warnings);
+  for (CalibrationWarning& warning : warnings) {
+    result.record.warnings.push_back(warning.text);
+    result.warnings.push_back(std::move(warning));
   }
   result.record.holdout_folds = folds;
   return result;
@@ -773,16 +781,8 @@ CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOpti
     progress.Step();
     for (const auto& [image, why] : record.holdout->not_evaluated)
       warnings.push_back({WarningCode::kViewLeftOut, image, image + ": held-out view not evaluated: " + why});
-    // 25 %: more than the few-percent spread of per-view RMS a well-posed fit shows between
-    // views of one set (the BabelCalib protocol's usual reading).
-    if (record.holdout->rms_px > 1.25 * record.rms_all_px) {
-      char text[300];
-      std::snprintf(text, sizeof text,
-                    "the %zu held-out views fit at %.3f px RMS against %.3f px for the training views: the model "
-                    "does not predict new views as well as it fits its own (too flexible, or too few views)",
-                    record.holdout->images.size(), record.holdout->rms_px, record.rms_all_px);
-      warnings.push_back({WarningCode::kHeldOutWorse, "", text});
-    }
+    WarnIfHeldOutWorse("the " + std::to_string(record.holdout->images.size()) + " held-out views fit at",
+                       record.holdout->rms_px, record.rms_all_px, &warnings);
   }
   if (options.cross_validate) {
     double distance_mm = options.cross_validation_distance_mm;

@@ -33,6 +33,13 @@ double AllCornerRms(const FitResult& fit) {
   return count ? std::sqrt(square / count) : NAN;
 }
 
+double AllCornerViewRms(const std::vector<Eigen::Vector2d>& residuals_px) {
+  double square = 0.0;
+  int count = 0;
+  AddView(residuals_px, &square, &count);
+  return count ? std::sqrt(square / count) : NAN;
+}
+
 HeldOutViews EvaluateHeldOutViews(const Sensor& sensor, const CalibrationTarget& target, const DetectionSet& views,
                                   FitOptions options) {
   HeldOutViews held;

@@ -30,6 +30,9 @@ std::vector<size_t> EvenlySpreadIndices(size_t total, size_t count);
 
 // Per-corner RMS over every fitted view's corners with a residual, outliers included.
 double AllCornerRms(const FitResult& fit);
+// The same over one view's residuals (NaN: none): how a held-out view's RMS is counted
+// (outliers are a fit's notion; a held-out view has none).
+double AllCornerViewRms(const std::vector<Eigen::Vector2d>& residuals_px);
 
 struct HeldOutViews {
   std::vector<std::string> images;               // held out, in the input's order

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "calib/cross_validation.h"
 #include "calib/image_file.h"
 #include "calib/report/plot.h"
 #include "calib/report/projection_diff_figure.h"
@@ -112,16 +113,6 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
 
 // Per-view RMS over all corners: the fitted views, then the held-out ones, with the
 // training RMS as a line to compare with.
-// A view's RMS over all its corners with a residual (NaN: none), as the held-out RMS is
-// (outliers are a fit's notion; a held-out view has none).
-double AllCornerViewRms(const std::vector<Eigen::Vector2d>& residuals) {
-  double square = 0.0;
-  int count = 0;
-  for (const Eigen::Vector2d& e : residuals)
-    if (e.allFinite()) square += e.squaredNorm(), ++count;
-  return count > 0 ? std::sqrt(square / count) : NAN;
-}
-
 // A bar from left to right at height `rms`, appended to a series' outline.
 void AppendBar(double left, double right, double rms, std::vector<double>* x, std::vector<double>* y) {
   x->insert(x->end(), {left, left, right, right});
