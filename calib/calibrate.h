@@ -63,6 +63,7 @@ struct CalibrationOptions {
   // f, f + F, f + 2F, ... of them; record.holdout_folds pools them. One split of a few views
   // is too few to judge by: on the real dev set the five splits of two views had held-out /
   // training ratios of 0.83-1.42, pooled 1.09 (docs/calibrate.md). Not with holdout_views.
+  // The folds reuse the full set's first detection pass (no fold changes it).
   int holdout_folds = 0;
   // Fit the board's out-of-plane warp (calib/board_warp.h) with the sensor.
   bool board_warp = false;

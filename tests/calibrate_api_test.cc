@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <regex>
+#include <set>
 #include <type_traits>
 #include <variant>
 
@@ -271,6 +272,47 @@ TEST(CalibrateApi, ARimCircleNotTheFitsRimIsReported) {
       EXPECT_NE(w.text.find("detection pass 2"), std::string::npos) << w.text;
     }
   EXPECT_EQ(reported, 1);
+}
+
+// Held-out folds from images (CalibrationOptions::holdout_folds) reuse the full set's
+// first detection pass instead of detecting every image again per fold (on the real dev
+// set the calibration with 5 folds went from 54 to 19 s of CPU, its results unchanged).
+// That is only right while the pass does not depend on which views are held out: a fold's
+// figures must equal those of a calibration that holds the same views out by name and
+// detects everything itself. Exact equality: the same arithmetic on the same corners
+// (both runs on 2 threads, whose work is split by view, not by timing). The 6-view
+// checkerboard render: 2 folds of 3 views, the second checked (~7 s on 2 cores).
+TEST(CalibrateApi, HeldOutFoldsEqualCalibrationsHoldingTheirViewsOut) {
+  const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/ohte-sph-checkerboard-near";
+  CalibrationInput input;
+  input.target_name = testing::SourceDir() + "/datasets-synthetic/targets/checkerboard-8x6-30mm.yaml";
+  input.target = CalibrationTarget::FromYaml(input.target_name);
+  input.image_paths = ListImages(set);
+  input.source = set;
+  input.guess_name = set + "/sensor.yaml";
+  input.guess = LoadSensorYaml(input.guess_name);
+  CalibrationOptions options;
+  options.threads = 2;
+  options.holdout_folds = 3;
+  const CalibrationResult folded = Calibrate(input, options);
+  ASSERT_TRUE(folded.record.holdout_folds);
+  const HeldOutFolds& folds = *folded.record.holdout_folds;
+  ASSERT_EQ(folds.folds.size(), 2u);
+  // The second fold: the first pass's detections were made by the full set's run, and
+  // one fold has used them before this one.
+  const HeldOutFolds::Fold& fold = folds.folds[1];
+  ASSERT_EQ(fold.images.size(), 3u);
+  CalibrationOptions alone;
+  alone.threads = 2;
+  alone.holdout_images = std::set<std::string>(fold.images.begin(), fold.images.end());
+  const CalibrationRecord record = Calibrate(input, alone).record;
+  ASSERT_TRUE(record.holdout);
+  EXPECT_EQ(record.holdout->images, fold.images);
+  EXPECT_EQ(record.holdout->corners, fold.corners);
+  EXPECT_GT(fold.corners, 100);
+  EXPECT_EQ(record.holdout->rms_px, fold.rms_px);
+  EXPECT_EQ(record.rms_all_px, fold.training_rms_px);
+  EXPECT_EQ(record.observations, fold.training_corners);
 }
 
 }  // namespace

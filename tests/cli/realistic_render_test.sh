@@ -33,11 +33,14 @@
 # bounded at 0.06 px. Predicted corners confirmed: 0.01-0.23 px from the truth, the worst a junction 0.75 px
 # inside the rim, bounded at 0.25 px (edge profiles read the black beyond the rim as ink: a
 # junction 4.5 px inside it went 2.6 px off until they were kept clear of it).
-# Usage: realistic_render_test.sh OMNICAL_BINARY SOURCE_DIR [aprilgrid|checkerboard]
+# KEEP_DIR (optional): the calibration is also copied there, whatever the checks say (the
+# decoy test compares against it: tests/cli/decoy_images_test.sh).
+# Usage: realistic_render_test.sh OMNICAL_BINARY SOURCE_DIR [aprilgrid|checkerboard] [KEEP_DIR]
 set -u
 omnical=$1
 source_dir=$(cd "$2" && pwd)
 kind=${3:-aprilgrid}
+keep=${4:-}
 data=$source_dir/datasets-synthetic
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -54,6 +57,9 @@ set_dir=$data/rendered/realistic-$kind
 "$omnical" -q calibrate --target "$target" --images "$set_dir" \
   --sensor "$data/sensors/ohte-sph-misaligned-guess.yaml" --board-warp --threads 2 --out "$work/cal" 2>/dev/null ||
   { echo "FAIL: calibrate exited $?"; exit 1; }
+if [ -n "$keep" ]; then
+  rm -rf "$keep.tmp" "$keep" && cp -r "$work/cal" "$keep.tmp" && mv "$keep.tmp" "$keep" || { echo "FAIL: keeping the calibration in $keep"; exit 1; }
+fi
 
 OMNICAL_CLI_TESTS=$source_dir/tests/cli python3 - "$set_dir" "$work/cal" "$found_floor" "$used_floor" "$corner_bound" "$predicted_floor" "$predicted_bound" <<'PY'
 import glob, json, math, os, sys
