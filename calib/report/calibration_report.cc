@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <utility>
 
 #include "calib/cross_validation.h"
 #include "calib/image_file.h"
@@ -119,8 +120,22 @@ void AppendBar(double left, double right, double rms, std::vector<double>* x, st
   y->insert(y->end(), {0.0, rms, rms, 0.0});
 }
 
+// Bars from 0 with a quarter of the height free above the tallest, where the legend goes
+// (drawn over the bars it hid a view's top).
+std::pair<double, double> BarsWithLegendRoom(const PlotPanel& panel) {
+  double top = 0.0;
+  for (const PlotSeries& s : panel.series)
+    for (double y : s.y)
+      if (std::isfinite(y)) top = std::max(top, y);
+  return {0.0, top > 0.0 ? 1.3 * top : 1.0};
+}
+
 void WriteHoldoutFigure(const std::string& path, const CalibrationResult& result, const HeldOutViews& held) {
-  PlotPanel panel("Per-view RMS over all corners: fitted views (left), held-out views (right)", "view", "RMS (px)");
+  const double training_rms_px = result.record.rms_all_px;
+  char title[200];
+  std::snprintf(title, sizeof title, "Per-view RMS, all corners: %zu held out at %.3f px, training %.3f px",
+                held.images.size(), held.rms_px, training_rms_px);
+  PlotPanel panel(title, "view (fitted, then held out)", "RMS (px)");
   std::vector<double> x, y;
   double v = 0.0;
   for (const std::vector<Eigen::Vector2d>& residuals : result.fit.residuals_px) {
@@ -137,12 +152,10 @@ void WriteHoldoutFigure(const std::string& path, const CalibrationResult& result
     v += 1.0;
   }
   panel.series.push_back(PlotSeries("held out", x, y, SeriesColor(1)));
-  char label[120];
-  const double training_rms_px = result.record.rms_all_px;
-  std::snprintf(label, sizeof label, "training RMS %.3f px, held out %.3f px", training_rms_px, held.rms_px);
-  PlotSeries training(label, {-0.5, v - 0.5}, {training_rms_px, training_rms_px}, SeriesColor(2));
+  PlotSeries training("training RMS", {-0.5, v - 0.5}, {training_rms_px, training_rms_px}, SeriesColor(2));
   training.dashed = true;
   panel.series.push_back(training);
+  panel.y_range = BarsWithLegendRoom(panel);
   WritePng(path, RenderPanel(panel, 800, 500));
 }
 
@@ -158,12 +171,13 @@ void WriteHoldoutFoldsFigure(const std::string& path, const CalibrationResult& r
     const double rms = AllCornerViewRms(result.fit.residuals_px[i]);
     const auto held = folds.per_view_rms_px.find(result.views.images[i].image);
     if (!std::isfinite(rms) || held == folds.per_view_rms_px.end()) continue;
-    AppendBar(v - 0.4, v, rms, &fitted_x, &fitted_y);
-    if (std::isfinite(held->second)) AppendBar(v, v + 0.4, held->second, &held_x, &held_y);
+    AppendBar(v - 0.4, v - 0.02, rms, &fitted_x, &fitted_y);
+    if (std::isfinite(held->second)) AppendBar(v + 0.02, v + 0.4, held->second, &held_x, &held_y);
     v += 1.0;
   }
   panel.series.push_back(PlotSeries("in the full fit", fitted_x, fitted_y, SeriesColor(0)));
   panel.series.push_back(PlotSeries("held out", held_x, held_y, SeriesColor(1)));
+  panel.y_range = BarsWithLegendRoom(panel);
   WritePng(path, RenderPanel(panel, 800, 500));
 }
 

@@ -53,6 +53,16 @@ void PutVerticalText(cv::Mat& image, const std::string& text, cv::Point centre, 
   if ((where & cv::Rect(0, 0, image.cols, image.rows)) == where) label.copyTo(image(where));
 }
 
+// The legend's entries: the labelled series', then the labelled bands'.
+std::vector<std::string> LegendLabels(const PlotPanel& panel) {
+  std::vector<std::string> labels;
+  for (const PlotSeries& s : panel.series)
+    if (!s.label.empty()) labels.push_back(s.label);
+  for (const PlotBand& b : panel.bands)
+    if (!b.label.empty()) labels.push_back(b.label);
+  return labels;
+}
+
 }  // namespace
 
 cv::Scalar SeriesColor(int index) {
@@ -127,11 +137,25 @@ cv::Mat RenderPanel(const PlotPanel& panel, int width_px, int height_px) {
       cv::line(canvas, cv::Point(to_px(s.x[i - 1], s.y[i - 1])) - offset, p, s.color, s.thickness, cv::LINE_AA);
     }
   }
-  // Legend, top right.
+  // Legend, top right: as wide as its longest label (a fixed width cut long ones at the
+  // panel's edge), on white so that the data under it do not cross its text.
+  int legend_rows = 0, label_width_px = 0;
+  for (const std::string& label : LegendLabels(panel)) {
+    int baseline = 0;
+    label_width_px = std::max(label_width_px, cv::getTextSize(label, kFont, 0.42, 1, &baseline).width);
+    ++legend_rows;
+  }
+  const int legend_width_px = std::min(plot.width - 8, 30 + label_width_px + 8);
+  const int legend_x = plot.x + plot.width - legend_width_px - 4;
+  if (legend_rows > 0) {
+    const cv::Rect box(legend_x - 6, plot.y + 2, legend_width_px + 8, 18 * legend_rows + 6);
+    cv::rectangle(image, box & plot, kWhite, cv::FILLED);
+    cv::rectangle(image, box & plot, kGrid, 1);
+  }
   int row = 0;
   for (const PlotSeries& s : panel.series) {
     if (s.label.empty()) continue;
-    const cv::Point at(plot.x + plot.width - 190, plot.y + 14 + 18 * row++);
+    const cv::Point at(legend_x, plot.y + 14 + 18 * row++);
     if (s.markers_only) {
       cv::circle(image, at + cv::Point(12, -4), s.thickness + 1, s.color, cv::FILLED, cv::LINE_AA);
     } else {
@@ -141,7 +165,7 @@ cv::Mat RenderPanel(const PlotPanel& panel, int width_px, int height_px) {
   }
   for (const PlotBand& b : panel.bands) {
     if (b.label.empty()) continue;
-    const cv::Point at(plot.x + plot.width - 190, plot.y + 14 + 18 * row++);
+    const cv::Point at(legend_x, plot.y + 14 + 18 * row++);
     cv::rectangle(image, cv::Rect(at + cv::Point(0, -9), cv::Size(24, 10)), cv::Scalar(215, 240, 215), cv::FILLED);
     PutText(image, b.label, at + cv::Point(30, 0), 0.42);
   }
