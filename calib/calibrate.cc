@@ -145,8 +145,11 @@ void WarnIfHeldOutWorse(const std::string& which, double held_rms_px, double tra
 
 // The views to keep out: those named, or `holdout` spread evenly over the usable views;
 // leaving >= 3.
-std::set<std::string> HoldoutNames(const CalibrationInput& input, const UsableViews& views, int holdout,
-                                   const std::set<std::string>& named) {
+// Named views need only be images of the set here: a view can become usable in a later
+// detection pass (a checkerboard found through the first fit; --holdout-folds names the
+// views of the last), so whether each is usable is checked after it (CheckHeldOutNamesUsable).
+std::set<std::string> HoldoutNames(const CalibrationInput& input, const DetectionSet& all, const UsableViews& views,
+                                   int holdout, const std::set<std::string>& named) {
   std::set<std::string> names;
   const size_t total = views.detections.images.size();
   const size_t asked = named.empty() ? static_cast<size_t>(std::max(holdout, 0)) : named.size();
@@ -156,15 +159,25 @@ std::set<std::string> HoldoutNames(const CalibrationInput& input, const UsableVi
                                       " usable leave fewer than 3 for the fit"));
   if (!named.empty()) {
     for (const std::string& name : named) {
-      const bool usable = std::any_of(views.detections.images.begin(), views.detections.images.end(),
-                                      [&](const ImageDetections& image) { return image.image == name; });
-      if (!usable) throw InputError(InputMessage(input.source, "holdout", name + ": not a usable view"));
+      const bool found = std::any_of(all.images.begin(), all.images.end(),
+                                     [&](const ImageDetections& image) { return image.image == name; });
+      if (!found) throw InputError(InputMessage(input.source, "holdout", name + ": not a usable view"));
     }
     names = named;
   } else if (holdout > 0) {
     for (size_t v : EvenlySpreadIndices(total, static_cast<size_t>(holdout))) names.insert(views.detections.images[v].image);
   }
   return names;
+}
+
+// After the last detection pass: every named held-out view was usable (split off).
+void CheckHeldOutNamesUsable(const CalibrationInput& input, const std::set<std::string>& named, const UsableViews& held) {
+  if (named.empty()) return;
+  for (const std::string& name : named) {
+    const bool usable = std::any_of(held.detections.images.begin(), held.detections.images.end(),
+                                    [&](const ImageDetections& image) { return image.image == name; });
+    if (!usable) throw InputError(InputMessage(input.source, "holdout", name + ": not a usable view"));
+  }
 }
 
 // The rim circle of the images a detections file names (the median over those that read).
@@ -344,13 +357,13 @@ std::string CalibrationOptions::Check() const {
 
 namespace {
 
-// One calibration (no folds). From images, *first_pass (when given) holds the first
-// detection pass: used if it has a value, else filled. That pass depends on the images,
-// the target, the guess and the detection options, none of which a held-out fold changes
-// (its views are detected with the rest and split off after), so the folds reuse the full
-// set's: on the real dev set it was ~70 % of each calibration's time.
+// One calibration (no folds). From images, the first detection pass is `reused` when given,
+// else run and, when `kept` is given, copied there. That pass depends on the images, the
+// target, the guess and the detection options, none of which a held-out fold changes (its
+// views are detected with the rest and split off after), so the folds reuse the full set's:
+// on the real dev set it was ~70 % of each calibration's time.
 CalibrationResult CalibrateOnce(const CalibrationInput& input, const CalibrationOptions& options,
-                                std::optional<DetectedImages>* first_pass);
+                                const DetectedImages* reused, DetectedImages* kept);
 
 // CalibrationOptions::holdout_folds: the full set's calibration, then one per fold with
 // that fold's views kept out (fitted without them, and refined in the later detection
@@ -358,8 +371,8 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
 CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const CalibrationOptions& options) {
   CalibrationOptions full_options = options;
   full_options.holdout_folds = 0;
-  std::optional<DetectedImages> first_pass;
-  CalibrationResult result = CalibrateOnce(input, full_options, &first_pass);
+  DetectedImages first_pass;
+  CalibrationResult result = CalibrateOnce(input, full_options, nullptr, &first_pass);
   std::vector<std::string> usable;  // the fitted views, in the input's order
   for (size_t v = 0; v < result.views.images.size(); ++v)
     if (v >= result.fit.view_left_out.size() || result.fit.view_left_out[v].empty())
@@ -381,7 +394,7 @@ CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const
   for (size_t f = 0; f < fold_count; ++f) {
     fold_options.holdout_images.clear();
     for (size_t v = f; v < usable.size(); v += fold_count) fold_options.holdout_images.insert(usable[v]);
-    const CalibrationRecord record = CalibrateOnce(input, fold_options, &first_pass).record;
+    const CalibrationRecord record = CalibrateOnce(input, fold_options, &first_pass, nullptr).record;
     const HeldOutViews& held = *record.holdout;
     HeldOutFolds::Fold fold;
     fold.images = held.images;
@@ -416,7 +429,7 @@ CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const
 }
 
 CalibrationResult CalibrateOnce(const CalibrationInput& input, const CalibrationOptions& options,
-                                std::optional<DetectedImages>* first_pass) {
+                                const DetectedImages* reused, DetectedImages* kept) {
   const int sources = !input.image_paths.empty() + !input.images.empty() + input.detections.has_value();
   if (sources != 1) throw InputError("images: give either images (detected here) or detections");
   const bool from_images = !input.detections;
@@ -444,12 +457,12 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     // are three quarters of a detection's time).
     // The rim circles start the fit without a guess, and place the rim for later passes.
     DetectedImages found;
-    if (first_pass && *first_pass) {
-      found = **first_pass;
+    if (reused) {
+      found = *reused;
     } else {
       found = FindCorners(input, options, input.guess, !input.guess || options.detection_passes > 1, true,
                           input.target.type() != CalibrationTarget::Type::kCheckerboard, options.detection_passes < 2);
-      if (first_pass) *first_pass = found;
+      if (kept) *kept = found;
     }
     detections = std::move(found.detections);
     warnings = std::move(found.warnings);
@@ -502,7 +515,8 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
 
   int unrefined = 0;
   UsableViews views = ViewsForFit(guess, input, FittableCorners(input, detections, &unrefined), &warnings);
-  const std::set<std::string> holdout_names = HoldoutNames(input, views, options.holdout_views, options.holdout_images);
+  const std::set<std::string> holdout_names =
+      HoldoutNames(input, detections, views, options.holdout_views, options.holdout_images);
   UsableViews held = SplitOff(&views, holdout_names);
   // Too few views to halve: said before the fit, not after it (the halves are of the views
   // the fit keeps, so this is necessary, and CrossValidateHalves checks again).
@@ -625,6 +639,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     held = SplitOff(&views, holdout_names);
     fit = FitSensor(*refit_start, input.target, views.detections, views.poses, fit_options);
   }
+  CheckHeldOutNamesUsable(input, options.holdout_images, held);
   Sensor fit_start = refit_start ? *refit_start : guess;
   // The corners changed: screened again, afresh if the first screen stopped (its pass-1
   // corners came through the design guess, and their warning no longer applies).
@@ -881,7 +896,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
 CalibrationResult Calibrate(const CalibrationInput& input, const CalibrationOptions& options) {
   if (const std::string why = options.Check(); !why.empty()) throw InputError(why);
   if (options.holdout_folds > 0) return CalibrateWithHeldOutFolds(input, options);
-  return CalibrateOnce(input, options, nullptr);
+  return CalibrateOnce(input, options, nullptr, nullptr);
 }
 
 }  // namespace omnical

@@ -294,7 +294,15 @@ TEST(CalibrateApi, HeldOutFoldsEqualCalibrationsHoldingTheirViewsOut) {
   CalibrationOptions options;
   options.threads = 2;
   options.holdout_folds = 3;
+  // And the folds do reuse it: one detection pass over every image, not one per calibration.
+  int passes_over_every_image = 0;
+  options.progress = [&](const ProgressUpdate& update) {
+    if (update.stage == "detect" && update.done == 0 && update.total == static_cast<long>(input.image_paths.size()))
+      ++passes_over_every_image;
+    return true;
+  };
   const CalibrationResult folded = Calibrate(input, options);
+  EXPECT_EQ(passes_over_every_image, 1);
   ASSERT_TRUE(folded.record.holdout_folds);
   const HeldOutFolds& folds = *folded.record.holdout_folds;
   ASSERT_EQ(folds.folds.size(), 2u);

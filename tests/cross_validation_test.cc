@@ -284,6 +284,20 @@ TEST(CalibrateGeneralisation, RefusesTooFewViewsToHoldOutOrHalve) {
   }
   options.holdout_views = -1;
   EXPECT_THROW(Calibrate(InputFromTruth(), options), InputError);
+  // Views named to hold out: an image not in the set, and one whose 3 corners leave it
+  // unusable, are both refused by name.
+  options.holdout_views = 0;
+  CalibrationInput input = InputFromTruth();
+  input.detections->images[2].corners.resize(3);
+  for (const std::string& name : {std::string("nowhere.png"), input.detections->images[2].image}) {
+    options.holdout_images = {name};
+    try {
+      Calibrate(input, options);
+      ADD_FAILURE() << name << ": no throw";
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find(name + ": not a usable view"), std::string::npos) << error.what();
+    }
+  }
 }
 
 }  // namespace

@@ -112,8 +112,6 @@ void WriteReport(const std::filesystem::path& dir, const DetectionSet& detection
   WritePng((dir / "per_view_rms.png").string(), RenderPanel(per_view, 800, 500));
 }
 
-// Per-view RMS over all corners: the fitted views, then the held-out ones, with the
-// training RMS as a line to compare with.
 // A bar from left to right at height `rms`, appended to a series' outline.
 void AppendBar(double left, double right, double rms, std::vector<double>* x, std::vector<double>* y) {
   x->insert(x->end(), {left, left, right, right});
@@ -130,11 +128,17 @@ std::pair<double, double> BarsWithLegendRoom(const PlotPanel& panel) {
   return {0.0, top > 0.0 ? 1.3 * top : 1.0};
 }
 
+// Per-view RMS over all corners: the fitted views, then the held-out ones, with the
+// training RMS as a line to compare with.
 void WriteHoldoutFigure(const std::string& path, const CalibrationResult& result, const HeldOutViews& held) {
   const double training_rms_px = result.record.rms_all_px;
   char title[200];
-  std::snprintf(title, sizeof title, "Per-view RMS, all corners: %zu held out at %.3f px, training %.3f px",
-                held.images.size(), held.rms_px, training_rms_px);
+  if (std::isfinite(held.rms_px))
+    std::snprintf(title, sizeof title, "Per-view RMS, all corners: %zu held out at %.3f px, training %.3f px",
+                  held.images.size(), held.rms_px, training_rms_px);
+  else
+    std::snprintf(title, sizeof title, "Per-view RMS, all corners: no held-out view evaluated, training %.3f px",
+                  training_rms_px);
   PlotPanel panel(title, "view (fitted, then held out)", "RMS (px)");
   std::vector<double> x, y;
   double v = 0.0;

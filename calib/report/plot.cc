@@ -138,20 +138,13 @@ cv::Mat RenderPanel(const PlotPanel& panel, int width_px, int height_px) {
     }
   }
   // Legend, top right: as wide as its longest label (a fixed width cut long ones at the
-  // panel's edge), on white so that the data under it do not cross its text.
-  int legend_rows = 0, label_width_px = 0;
+  // panel's edge). Drawn over the data, not on a box that would hide where curves end.
+  int label_width_px = 0;
   for (const std::string& label : LegendLabels(panel)) {
     int baseline = 0;
     label_width_px = std::max(label_width_px, cv::getTextSize(label, kFont, 0.42, 1, &baseline).width);
-    ++legend_rows;
   }
-  const int legend_width_px = std::min(plot.width - 8, 30 + label_width_px + 8);
-  const int legend_x = plot.x + plot.width - legend_width_px - 4;
-  if (legend_rows > 0) {
-    const cv::Rect box(legend_x - 6, plot.y + 2, legend_width_px + 8, 18 * legend_rows + 6);
-    cv::rectangle(image, box & plot, kWhite, cv::FILLED);
-    cv::rectangle(image, box & plot, kGrid, 1);
-  }
+  const int legend_x = plot.x + plot.width - std::min(plot.width - 8, 30 + label_width_px + 8) - 4;
   int row = 0;
   for (const PlotSeries& s : panel.series) {
     if (s.label.empty()) continue;

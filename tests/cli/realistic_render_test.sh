@@ -34,7 +34,8 @@
 # inside the rim, bounded at 0.25 px (edge profiles read the black beyond the rim as ink: a
 # junction 4.5 px inside it went 2.6 px off until they were kept clear of it).
 # KEEP_DIR (optional): the calibration is also copied there, whatever the checks say (the
-# decoy test compares against it: tests/cli/decoy_images_test.sh).
+# decoy test compares against it: tests/cli/decoy_images_test.sh; under CTest it is not run
+# when this test fails, its fixture's setup).
 # Usage: realistic_render_test.sh OMNICAL_BINARY SOURCE_DIR [aprilgrid|checkerboard] [KEEP_DIR]
 set -u
 omnical=$1
@@ -53,6 +54,7 @@ case $kind in
   *) echo "FAIL: unknown set kind '$kind'"; exit 1 ;;
 esac
 set_dir=$data/rendered/realistic-$kind
+[ -z "$keep" ] || rm -rf "$keep"  # never an earlier run's, should this one fail
 
 "$omnical" -q calibrate --target "$target" --images "$set_dir" \
   --sensor "$data/sensors/ohte-sph-misaligned-guess.yaml" --board-warp --threads 2 --out "$work/cal" 2>/dev/null ||
