@@ -170,14 +170,19 @@ std::set<std::string> HoldoutNames(const CalibrationInput& input, const Detectio
   return names;
 }
 
-// After the last detection pass: every named held-out view was usable (split off).
-void CheckHeldOutNamesUsable(const CalibrationInput& input, const std::set<std::string>& named, const UsableViews& held) {
-  if (named.empty()) return;
-  for (const std::string& name : named) {
-    const bool usable = std::any_of(held.detections.images.begin(), held.detections.images.end(),
-                                    [&](const ImageDetections& image) { return image.image == name; });
-    if (!usable) throw InputError(InputMessage(input.source, "holdout", name + ": not a usable view"));
-  }
+// After the last detection pass: every named held-out view was usable (split off) in some
+// pass. One usable in the first pass and not in a later one is not refused: a fold of
+// --holdout-folds refines its corners through its own fit, and one view lost there should
+// not end the whole evaluation.
+void CheckHeldOutNamesUsable(const CalibrationInput& input, const std::set<std::string>& named,
+                             const std::set<std::string>& ever_held) {
+  for (const std::string& name : named)
+    if (!ever_held.count(name)) throw InputError(InputMessage(input.source, "holdout", name + ": not a usable view"));
+}
+
+// Adds the names of `held`'s views to *names.
+void AddViewNames(const UsableViews& held, std::set<std::string>* names) {
+  for (const ImageDetections& image : held.detections.images) names->insert(image.image);
 }
 
 // The rim circle of the images a detections file names (the median over those that read).
@@ -518,6 +523,8 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   const std::set<std::string> holdout_names =
       HoldoutNames(input, detections, views, options.holdout_views, options.holdout_images);
   UsableViews held = SplitOff(&views, holdout_names);
+  std::set<std::string> ever_held;  // the named views usable in some pass
+  AddViewNames(held, &ever_held);
   // Too few views to halve: said before the fit, not after it (the halves are of the views
   // the fit keeps, so this is necessary, and CrossValidateHalves checks again).
   if (const size_t half = views.detections.images.size() / 2; options.cross_validate && half < 3)
@@ -637,9 +644,10 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     views = ViewsForFit(*refit_start, input, FittableCorners(input, WithoutImages(detections, refused_images), &unrefined),
                         &warnings);
     held = SplitOff(&views, holdout_names);
+    AddViewNames(held, &ever_held);
     fit = FitSensor(*refit_start, input.target, views.detections, views.poses, fit_options);
   }
-  CheckHeldOutNamesUsable(input, options.holdout_images, held);
+  CheckHeldOutNamesUsable(input, options.holdout_images, ever_held);
   Sensor fit_start = refit_start ? *refit_start : guess;
   // The corners changed: screened again, afresh if the first screen stopped (its pass-1
   // corners came through the design guess, and their warning no longer applies).
