@@ -23,8 +23,9 @@ const char* const kHoldoutDefinition =
     "views kept out of the fit (spread evenly over the input), their poses fitted with the sensor held; rms_px over "
     "all their corners, per corner sqrt(mean |e|^2); compare with training_rms_px (the fitted views, all corners)";
 const char* const kHoldoutFoldsDefinition =
-    "every usable view held out once, views_per_fold at a time: per fold a calibration without its views (detected and "
-    "fitted without them; fold f of F keeps out the usable views f, f + F, ... in the input's order), their poses "
+    "every usable view held out once, views_per_fold at a time: per fold a calibration without its views (fitted "
+    "without them, their corners refined in the later detection passes through fits without them; fold f of F keeps "
+    "out the usable views f, f + F, ... in the input's order), their poses "
     "fitted with that sensor held; rms_px over every fold's held-out corners, training_rms_px over every fold's "
     "fitted corners, both all corners, per corner sqrt(mean |e|^2); the written sensor is the full set's fit";
 const char* const kBoardWarpDefinition =
