@@ -117,8 +117,10 @@ int Main(bool check) {
   const cv::Matx14d D(-0.05, 0.01, 0.0, 0.0);
   const cv::Mat xi = (cv::Mat_<double>(1, 1) << 1.2);
   const cv::Matx33d Knew(2048.0 / 3.1416, 0.0, 0.0, 0.0, 512.0 / 3.1416, 0.0, 0.0, 0.0, 1.0);
-  cv::Mat cv_map1, cv_map2;
+  // Each call makes its maps afresh, as BuildRemapTable returns a new table: both pay for
+  // new memory (on some virtual machines the page faults of a new table outweigh its computation).
   auto opencv_maps = [&]() {
+    cv::Mat cv_map1, cv_map2;
     cv::omnidir::initUndistortRectifyMap(K, D, xi, cv::Matx33d::eye(), Knew, cv::Size(2048, 512), CV_32FC1, cv_map1,
                                          cv_map2, cv::omnidir::RECTIFY_CYLINDRICAL);
   };
