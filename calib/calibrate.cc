@@ -673,53 +673,23 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     const std::string base = guess_profile.empty() || guess_profile == "spline" ? "polynomial" : guess_profile;
     KnotChoice& choice = *(record.knot_choice =
                                ChooseKnots(fit_start, base, input.target, kept, kept_poses, fit_options, options.progress));
-    // The folds score how well a count predicts; the full fit with it may still bend the
-    // mirror more than a mirror can (z'' <= 0 where few corners reach, by the rim), and
-    // its sensor.yaml would not load. Then the same rule among the counts not yet tried,
-    // until a full fit is a valid mirror (none: the folds' choice, with the validation
-    // warning below).
     const int folds_choice = choice.chosen;
-    std::vector<bool> tried(choice.candidates.size(), false);
-    // The valid fit once found, else the first that fitted at all.
-    std::optional<std::pair<FitResult, Sensor>> first_fitted;
-    int first_fitted_knots = folds_choice;
-    std::optional<FitResult> first_failed;  // its report, should no count fit at all
-    std::string rejected;
-    bool valid = false;
-    for (int k = PreferredKnotCount(choice, tried); k >= 0 && !valid; k = PreferredKnotCount(choice, tried)) {
-      tried[k] = true;
-      const int knots = choice.candidates[k];
+    ValidKnotFit chosen_fit = FitValidKnotCount(choice, base, [&](int knots) {
       Sensor start = knots > 0 ? ConvertProfile(fit_start, "spline", knots) : ConvertProfile(fit_start, base);
-      FitResult candidate_fit = FitSensor(start, input.target, views.detections, views.poses, WithShapeOf(fit_options, start));
-      const std::string name = knots > 0 ? std::to_string(knots) + " knots" : base;
-      if (candidate_fit.sensor && ValidateSensorModel(candidate_fit.sensor->model()).empty()) {
-        valid = true;
-        first_fitted.emplace(std::move(candidate_fit), std::move(start));
-        first_fitted_knots = knots;
-      } else {
-        rejected += (rejected.empty() ? "" : ", ") + name + (candidate_fit.sensor ? " (no valid mirror)" : " (no fit)");
-        if (!first_fitted && candidate_fit.sensor) {
-          first_fitted.emplace(std::move(candidate_fit), std::move(start));
-          first_fitted_knots = knots;
-        } else if (!candidate_fit.sensor && !first_failed) {
-          first_failed = std::move(candidate_fit);
-        }
-      }
-    }
-    if (first_fitted) {
-      fit = std::move(first_fitted->first), fit_start = std::move(first_fitted->second);
-      choice.chosen = first_fitted_knots;
-    } else if (first_failed) {
-      fit = std::move(*first_failed);  // no sensor: "the fit failed" below
+      FitResult result = FitSensor(start, input.target, views.detections, views.poses, WithShapeOf(fit_options, start));
+      return KnotCountFit{std::move(result), std::move(start)};
+    });
+    if (chosen_fit.fitted) {
+      fit = std::move(chosen_fit.fitted->fit), fit_start = std::move(chosen_fit.fitted->start);
+      choice.chosen = chosen_fit.knots;
+    } else if (chosen_fit.failed) {
+      fit = std::move(*chosen_fit.failed);  // no sensor: "the fit failed" below
     }
     fit_options = WithShapeOf(fit_options, fit_start);
     const int chosen = choice.chosen;
     record.start += chosen > 0 ? ", " + std::to_string(chosen) + " knots" : ", the " + base + " mirror";
     record.start += chosen == folds_choice ? " (chosen by held-out folds)" : " (held-out folds' next choice)";
-    if (chosen != folds_choice)
-      knot_fallback = "the full set fitted with " + rejected + "; " +
-                      (chosen > 0 ? std::to_string(chosen) + " knots" : "the " + base + " mirror") +
-                      ", the folds' next choice, fitted instead" + (valid ? "" : " (no valid mirror either)");
+    knot_fallback = chosen_fit.replaced;
   }
   const DetectionSet& usable = views.detections;
   if (!fit.sensor) throw InputError(InputMessage(input.source, "", "the fit failed: " + fit.solver_report));

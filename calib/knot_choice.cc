@@ -11,6 +11,7 @@
 #include "model/input_error.h"
 #include "model/parallel_rows.h"
 #include "model/progress.h"
+#include "model/sensor.h"
 
 namespace omnical {
 
@@ -47,6 +48,37 @@ int PreferredKnotCount(const KnotChoice& choice, const std::vector<bool>& exclud
   for (size_t k = 0; k < choice.candidates.size(); ++k)
     if (!excluded[k] && choice.held_out_rms_px[k] <= best * (1.0 + kKnotScoreTolerance)) return static_cast<int>(k);
   return -1;
+}
+
+ValidKnotFit FitValidKnotCount(const KnotChoice& choice, const std::string& base_profile,
+                               const std::function<KnotCountFit(int knots)>& fit_count) {
+  const auto name = [&](int knots) { return knots > 0 ? std::to_string(knots) + " knots" : "the " + base_profile + " mirror"; };
+  ValidKnotFit result;
+  result.knots = choice.chosen;
+  std::vector<bool> tried(choice.candidates.size(), false);
+  std::string rejected;
+  for (int k = PreferredKnotCount(choice, tried); k >= 0 && !result.valid; k = PreferredKnotCount(choice, tried)) {
+    tried[k] = true;
+    const int knots = choice.candidates[k];
+    KnotCountFit candidate = fit_count(knots);
+    const bool fitted = candidate.fit.sensor.has_value();
+    const bool valid = fitted && ValidateSensorModel(candidate.fit.sensor->model()).empty();
+    if (valid || (fitted && !result.fitted)) {
+      result.fitted = std::move(candidate);
+      result.knots = knots;
+      result.valid = valid;
+    } else if (!fitted && !result.failed) {
+      result.failed = std::move(candidate.fit);
+    }
+    if (!valid) {
+      const std::string label = knots > 0 ? std::to_string(knots) + " knots" : base_profile;
+      rejected += (rejected.empty() ? "" : ", ") + label + (fitted ? " (no valid mirror)" : " (no fit)");
+    }
+  }
+  if (result.fitted && result.knots != choice.chosen)
+    result.replaced = "the full set fitted with " + rejected + "; " + name(result.knots) +
+                      ", the folds' next choice, fitted instead" + (result.valid ? "" : " (no valid mirror either)");
+  return result;
 }
 
 KnotChoice ChooseKnots(const Sensor& start, const std::string& base_profile, const CalibrationTarget& target,

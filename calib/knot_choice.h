@@ -7,6 +7,8 @@
 // corner of every fold, per corner sqrt(mean |e|^2).
 #pragma once
 
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,6 +50,35 @@ struct KnotChoice {
 // (no spline first) whose held-out RMS is within kKnotScoreTolerance of the lowest of
 // them; -1 when none has a score.
 int PreferredKnotCount(const KnotChoice& choice, const std::vector<bool>& excluded);
+
+// The full set fitted with one count: FitSensor's result and the sensor it started from.
+struct KnotCountFit {
+  FitResult fit;
+  Sensor start;
+};
+
+// What calibrate fits after the folds: the full set with the preferred count. The folds
+// score how well a count predicts; the full fit with it may still bend the mirror more
+// than a mirror can (z'' <= 0 where few corners reach, by the rim), and its sensor.yaml
+// would not load (ValidateSensorModel). Then PreferredKnotCount among the counts not yet
+// tried, until a full fit is a valid mirror.
+struct ValidKnotFit {
+  // The valid fit; if none, the first count that fitted at all (invalid); if none
+  // fitted, empty and `failed` holds the first failure's result (its solver report).
+  std::optional<KnotCountFit> fitted;
+  std::optional<FitResult> failed;
+  int knots = 0;  // fitted's count; the folds' choice when nothing fitted
+  bool valid = false;
+  // Why the count fitted is not the folds' choice, one line ("the full set fitted with 12
+  // knots (no valid mirror); 8 knots, the folds' next choice, fitted instead"); empty
+  // when it is.
+  std::string replaced;
+};
+
+// fit_count(knots): the full set's fit with that candidate count (0: the base family,
+// named base_profile in `replaced`).
+ValidKnotFit FitValidKnotCount(const KnotChoice& choice, const std::string& base_profile,
+                               const std::function<KnotCountFit(int knots)>& fit_count);
 
 // The fit options for a candidate of another shape (knot count or family): the design
 // values the priors are centred on keep every parameter the candidate shares with the

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <random>
 
@@ -568,6 +569,90 @@ TEST(KnotChoice, PreferredCountIsTheFewestWithinOnePercentOfTheRest) {
   EXPECT_EQ(PreferredKnotCount(choice, tried), 0);
   tried[0] = true;
   EXPECT_EQ(PreferredKnotCount(choice, tried), -1);
+}
+
+// After the folds, calibrate fits the full set with their count and, where that fit is no
+// valid mirror, with the next preferred count (FitValidKnotCount). The fits are stand-ins
+// here, so every branch runs deterministically: a valid spline (BumpedSplineProfile) or
+// the same spline dented 20-fold inwards, which the sensor check refuses (z'' < 0; the
+// threshold is ~1.3-fold, tests/spline_profile_test.cc); each fit's rms_px is its count,
+// to tell which one came back.
+TEST(KnotChoice, AFullFitThatIsNoValidMirrorIsReplacedByTheNextPreferredCount) {
+  const Sensor valid(testing::MakeModel<SplineProfile, PinholeLens>(testing::BumpedSplineProfile(), 180.0, false));
+  SplineProfile<double> dented = testing::BumpedSplineProfile();
+  for (int k = 0; k < dented.num_knots; ++k) dented.knots_mm[k] *= -20.0;
+  const Sensor invalid(testing::MakeModel<SplineProfile, PinholeLens>(dented, 180.0, false));
+  ASSERT_EQ(ValidateSensorModel(valid.model()), "");
+  ASSERT_NE(ValidateSensorModel(invalid.model()), "");
+
+  KnotChoice choice;  // the figure-error set's scores: 12 preferred, then 16, then 8
+  choice.base_profile = "sphere";
+  choice.candidates = kKnotCandidates;
+  choice.held_out_rms_px = {0.6724, 0.2017, 0.1570, 0.1423, 0.1407, 0.1406};
+  choice.chosen = 12;
+  enum class Outcome { kValid, kInvalid, kNoFit };
+  std::map<int, Outcome> outcome;
+  std::vector<int> asked;
+  const auto fit_count = [&](int knots) {
+    asked.push_back(knots);
+    FitResult fit;
+    fit.rms_px = knots;
+    fit.solver_report = "report of " + std::to_string(knots);
+    const Outcome o = outcome.count(knots) ? outcome[knots] : Outcome::kValid;
+    if (o != Outcome::kNoFit) fit.sensor = o == Outcome::kValid ? valid : invalid;
+    return KnotCountFit{std::move(fit), valid};
+  };
+
+  // Runs the rule with these fits' outcomes; checks which counts it fitted, in order.
+  const auto run = [&](std::map<int, Outcome> outcomes, const std::vector<int>& expected_asked) {
+    outcome = std::move(outcomes);
+    asked.clear();
+    ValidKnotFit result = FitValidKnotCount(choice, "sphere", fit_count);
+    EXPECT_EQ(asked, expected_asked);
+    return result;
+  };
+  // The fit it kept: its count (the stand-in's rms_px says which fit came back), whether
+  // valid, and what it says.
+  const auto expect_kept = [](const ValidKnotFit& result, int knots, bool valid, const std::string& replaced) {
+    ASSERT_TRUE(result.fitted);
+    EXPECT_EQ(result.valid, valid);
+    EXPECT_EQ(result.knots, knots);
+    EXPECT_EQ(result.fitted->fit.rms_px, knots);
+    EXPECT_EQ(result.replaced, replaced);
+  };
+  const Outcome no = Outcome::kInvalid;
+
+  // The folds' count is a valid mirror: fitted once, nothing replaced.
+  expect_kept(run({}, {12}), 12, true, "");
+  // 12 and 16 bend past a mirror: 8, the next by the same rule, is fitted and said so.
+  expect_kept(run({{12, no}, {16, no}}, {12, 16, 8}), 8, true,
+              "the full set fitted with 12 knots (no valid mirror), 16 knots (no valid mirror); 8 knots, the folds' "
+              "next choice, fitted instead");
+  // No count is a valid mirror: the folds' own (the first that fitted) is kept, invalid;
+  // nothing is said here (calibrate warns that the sensor fails validation).
+  const std::map<int, Outcome> none_valid = {{0, no}, {4, no}, {6, no}, {8, no}, {12, no}, {16, no}};
+  expect_kept(run(none_valid, {12, 16, 8, 6, 4, 0}), 12, false, "");
+  // The folds' count does not fit at all and no other is valid: the first that fitted
+  // (16), with both said.
+  std::map<int, Outcome> outcomes = none_valid;
+  outcomes[12] = Outcome::kNoFit;
+  expect_kept(run(outcomes, {12, 16, 8, 6, 4, 0}), 16, false,
+              "the full set fitted with 12 knots (no fit), 16 knots (no valid mirror), 8 knots (no valid mirror), 6 "
+              "knots (no valid mirror), 4 knots (no valid mirror), sphere (no valid mirror); 16 knots, the folds' next "
+              "choice, fitted instead (no valid mirror either)");
+  // Nothing fits: no sensor, the first failure's report for calibrate's error.
+  for (auto& entry : outcomes) entry.second = Outcome::kNoFit;
+  const ValidKnotFit nothing = run(outcomes, {12, 16, 8, 6, 4, 0});
+  EXPECT_FALSE(nothing.fitted);
+  ASSERT_TRUE(nothing.failed);
+  EXPECT_EQ(nothing.failed->solver_report, "report of 12");
+  EXPECT_EQ(nothing.knots, 12);
+  EXPECT_EQ(nothing.replaced, "");
+  // Where the base family is the next preferred, it replaces the spline under its name.
+  choice.held_out_rms_px = {0.1410, 0.2017, 0.1570, 0.1423, 0.1390, 0.1500};  // 12; then the sphere
+  expect_kept(run({{12, no}}, {12, 0}), 0, true,
+              "the full set fitted with 12 knots (no valid mirror); the sphere mirror, the folds' next choice, fitted "
+              "instead");
 }
 
 // The spline's knot count by held-out folds (calib/knot_choice.h), on corners with 0.1 px
