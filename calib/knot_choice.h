@@ -42,7 +42,7 @@ struct KnotChoice {
   int folds = 0;
   // The count the sensor was fitted with: PreferredKnotCount's among every candidate, or,
   // where calibrate's full fit with that count was no valid mirror, its pick among the
-  // counts not yet tried (calib/calibrate.cc).
+  // counts not yet tried (FitValidKnotCount).
   int chosen = 0;
 };
 

@@ -552,8 +552,9 @@ TEST(FitOptions, CheckRefusesInvalidSolverSettings) {
 }
 
 // The parsimony rule over the counts not excluded (calibrate re-applies it when the
-// folds' count fits the full set to no valid mirror). Scores as measured on the
-// figure-error set (docs/calibrate.md): 12 is within 1 % of 16's lowest, 8 is not.
+// folds' count fits the full set to no valid mirror). Scores as an earlier version of
+// cli.figure_error_spline measured (focal length free): 12 is within 1 % of 16's lowest,
+// 8 is not.
 TEST(KnotChoice, PreferredCountIsTheFewestWithinOnePercentOfTheRest) {
   KnotChoice choice;
   choice.candidates = kKnotCandidates;
@@ -574,9 +575,10 @@ TEST(KnotChoice, PreferredCountIsTheFewestWithinOnePercentOfTheRest) {
 // After the folds, calibrate fits the full set with their count and, where that fit is no
 // valid mirror, with the next preferred count (FitValidKnotCount). The fits are stand-ins
 // here, so every branch runs deterministically: a valid spline (BumpedSplineProfile) or
-// the same spline dented 20-fold inwards, which the sensor check refuses (z'' < 0; the
-// threshold is ~1.3-fold, tests/spline_profile_test.cc); each fit's rms_px is its count,
-// to tell which one came back.
+// the same spline dented 20-fold inwards, which the sensor check refuses (z' or z'' <= 0
+// before the rim; tests/spline_profile_test.cc finds where a dent starts to be refused).
+// Each fit's rms_px is its count and its start's m is 100 mm + the count, to tell which
+// fit and which start came back.
 TEST(KnotChoice, AFullFitThatIsNoValidMirrorIsReplacedByTheNextPreferredCount) {
   const Sensor valid(testing::MakeModel<SplineProfile, PinholeLens>(testing::BumpedSplineProfile(), 180.0, false));
   SplineProfile<double> dented = testing::BumpedSplineProfile();
@@ -585,7 +587,7 @@ TEST(KnotChoice, AFullFitThatIsNoValidMirrorIsReplacedByTheNextPreferredCount) {
   ASSERT_EQ(ValidateSensorModel(valid.model()), "");
   ASSERT_NE(ValidateSensorModel(invalid.model()), "");
 
-  KnotChoice choice;  // the figure-error set's scores: 12 preferred, then 16, then 8
+  KnotChoice choice;  // the scores above: 12 preferred, then 16, then 8
   choice.base_profile = "sphere";
   choice.candidates = kKnotCandidates;
   choice.held_out_rms_px = {0.6724, 0.2017, 0.1570, 0.1423, 0.1407, 0.1406};
@@ -600,7 +602,14 @@ TEST(KnotChoice, AFullFitThatIsNoValidMirrorIsReplacedByTheNextPreferredCount) {
     fit.solver_report = "report of " + std::to_string(knots);
     const Outcome o = outcome.count(knots) ? outcome[knots] : Outcome::kValid;
     if (o != Outcome::kNoFit) fit.sensor = o == Outcome::kValid ? valid : invalid;
-    return KnotCountFit{std::move(fit), valid};
+    return KnotCountFit{std::move(fit),
+                        Sensor(testing::MakeModel<SplineProfile, PinholeLens>(testing::BumpedSplineProfile(), 100.0 + knots,
+                                                                             false))};
+  };
+  const auto start_m_mm = [](const Sensor& start) {
+    for (const ParameterEstimate& p : SensorParameters(start))
+      if (p.name == "m_mm") return p.value;
+    return double(NAN);
   };
 
   // Runs the rule with these fits' outcomes; checks which counts it fitted, in order.
@@ -613,11 +622,12 @@ TEST(KnotChoice, AFullFitThatIsNoValidMirrorIsReplacedByTheNextPreferredCount) {
   };
   // The fit it kept: its count (the stand-in's rms_px says which fit came back), whether
   // valid, and what it says.
-  const auto expect_kept = [](const ValidKnotFit& result, int knots, bool valid, const std::string& replaced) {
+  const auto expect_kept = [&](const ValidKnotFit& result, int knots, bool valid, const std::string& replaced) {
     ASSERT_TRUE(result.fitted);
     EXPECT_EQ(result.valid, valid);
     EXPECT_EQ(result.knots, knots);
     EXPECT_EQ(result.fitted->fit.rms_px, knots);
+    EXPECT_NEAR(start_m_mm(result.fitted->start), 100.0 + knots, 1e-9);
     EXPECT_EQ(result.replaced, replaced);
   };
   const Outcome no = Outcome::kInvalid;
