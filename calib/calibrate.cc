@@ -271,6 +271,13 @@ DetectionSet CornersRefinedThrough(const CalibrationInput& input, const Calibrat
 FitOptions FitOptionsFor(const CalibrationInput& input, const CalibrationOptions& options, const Sensor& start,
                          std::vector<CalibrationWarning>* warnings) {
   FitOptions fit = FitOptions::DefaultsFor(start);
+  // A pinhole in front of a free-form mirror the rim circle started: the gauges of an
+  // unknown shape, with no design to hold them at (CalibrationOptions::lens). Free, m and
+  // decenter slid along their valleys (std 5.5 % of m on
+  // rendered/ohte-sph-misaligned-near) and a decenter started a wrong tilt basin. A
+  // sphere's or a paraboloid's are observable, as with a guess.
+  const bool free_form = std::visit([](const auto& model) { return HasFreeFormTerms(model.mirror); }, start.model());
+  if (!input.guess && std::string(start.lens_name()) == "pinhole" && free_form) fit.refine.m = fit.refine.decenter = false;
   if (const std::string why = fit.refine.Hold(options.fixed); !why.empty()) throw InputError(why);
   fit.robust_loss_px = options.loss_px;
   fit.fit_board_warp = options.board_warp;
@@ -335,6 +342,8 @@ std::string CalibrationOptions::Check() const {
   if (!profile.empty() && std::find(profiles.begin(), profiles.end(), profile) == profiles.end())
     return "profile: unknown mirror family '" + profile + "' (" + JoinChoices(profiles) + ")";
   if (!(rim_field_deg >= 10.0 && rim_field_deg <= 170.0)) return "rim_field_deg: must lie in 10-170 deg";
+  if (!lens.empty() && lens != "orthographic" && lens != "pinhole" && lens != kChooseLens)
+    return "lens: the rim circle starts an orthographic or a pinhole lens, or 'auto' (got '" + lens + "')";
   if (!(loss_px >= 0.0 && std::isfinite(loss_px))) return "loss_px: must be >= 0 and finite";
   if (max_iterations < 1) return "max_iterations: must be >= 1";
   // Pass 2 re-detects through the first fit; an aprilgrid's later passes through the last.
@@ -391,6 +400,9 @@ CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const
   CalibrationOptions fold_options = full_options;
   fold_options.cross_validate = false;  // each fold answers one question: how well it predicts its views
   fold_options.leave_one_out = false;
+  // The lens the full set chose (choosing again would be 10 fits more per fold, and a
+  // fold could judge another lens than the calibration written).
+  if (const auto& lens = result.record.lens_choice) fold_options.lens = lens->chosen;
   std::vector<CalibrationWarning> warnings;  // the folds' own, added to the full set's below
   HeldOutFolds folds;
   folds.views_per_fold = options.holdout_folds;
@@ -438,6 +450,9 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   const int sources = !input.image_paths.empty() + !input.images.empty() + input.detections.has_value();
   if (sources != 1) throw InputError("images: give either images (detected here) or detections");
   const bool from_images = !input.detections;
+  if (input.guess && !options.lens.empty())
+    throw InputError(InputMessage(input.guess_name, "lens", "the guess has its lens (" + std::string(input.guess->lens_name()) +
+                                                                "): lens chooses the rim circle's start, without a guess"));
   // Said, not ignored: how a checkerboard's corners are refined is a step of the second
   // detection pass over its images (unset: edges wherever that applies).
   const bool refinement_asked = options.checkerboard_edges.has_value();
@@ -486,7 +501,13 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     if (!input.guess) rim = RimOfImages(detections);
   }
   // The starting sensor: the guess (in another profile family if asked), or, with no
-  // guess, the rim circle of the images.
+  // guess, the rim circle of the images through a lens (each lens's, to choose one).
+  const std::string rim_profile = options.profile.empty() ? "polynomial" : options.profile;
+  const auto rim_start = [&](const std::string& lens) {
+    const Sensor start =
+        SensorFromRimCircle(*rim, detections.image_width_px, detections.image_height_px, rim_profile, options.rim_field_deg, lens);
+    return options.knots > 0 && rim_profile == "spline" ? ConvertProfile(start, "spline", options.knots) : start;
+  };
   std::optional<Sensor> start_sensor;
   if (input.guess) {
     start_sensor = options.profile.empty() ? *input.guess : ConvertProfile(*input.guess, options.profile);
@@ -495,9 +516,9 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   } else {
     if (!rim)
       throw InputError(InputMessage(input.source, "images", "no mirror rim circle found to start from; give a sensor guess"));
-    const std::string profile = options.profile.empty() ? "polynomial" : options.profile;
-    start_sensor = SensorFromRimCircle(*rim, detections.image_width_px, detections.image_height_px, profile, options.rim_field_deg);
-    record.start = "rim circle, " + profile + " mirror, orthographic lens";
+    const std::string lens = options.lens.empty() || options.lens == kChooseLens ? "orthographic" : options.lens;
+    start_sensor = rim_start(lens);
+    record.start = "rim circle, " + rim_profile + " mirror, " + lens + " lens";
     record.rim_circle = CalibrationRecord::RimCircleRecord{rim->centre_px, rim->radius_px, rim->inlier_fraction, rim->rms_px};
   }
   if (options.knots != 0) {
@@ -508,8 +529,11 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     if (options.knots > 0) start_sensor = ConvertProfile(*start_sensor, "spline", options.knots);
   }
   const Sensor& guess = *start_sensor;
-  for (double n : options.distances_n)  // in the start's rim radii: known only now, and before any fit
-    if (const std::string why = ObjectDistanceProblem(n * guess.rim_radius_mm()); !why.empty())
+  // n counts the design's rim radii; from the rim circle the nominal one's (a pinhole's
+  // start reaches past it, calib/initial_sensor.h).
+  const double design_rim_mm = input.guess ? guess.rim_radius_mm() : kNominalRimRadiusMm;
+  for (double n : options.distances_n)  // known only now, and before any fit
+    if (const std::string why = ObjectDistanceProblem(n * design_rim_mm); !why.empty())
       throw InputError("distances_n: " + why);
   if (detections.image_width_px != guess.image_width_px() || detections.image_height_px != guess.image_height_px())
     throw InputError(InputMessage(input.source, "image_size",
@@ -530,6 +554,49 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   if (const size_t half = views.detections.images.size() / 2; options.cross_validate && half < 3)
     throw InputError("cross_validate: half 2 has " + std::to_string(half) +
                      " views (need >= 3 per half, >= 6 usable views in all)");
+  // Without a guess, the lens by held-out folds on the first pass's corners, before the
+  // corners are refined through a fit with it (calib/lens_choice.h).
+  if (options.lens == kChooseLens) {
+    std::vector<std::optional<FoldCandidate>> candidates;
+    for (const std::string& lens : kLensCandidates) {
+      if (lens == guess.lens_name()) {
+        candidates.push_back(FoldCandidate{guess, fit_options, views.poses});
+        continue;
+      }
+      // Another lens that cannot start (a rim ray it cannot reach, a tolerance on a
+      // parameter it lacks) or pose every view is no candidate: scored NaN.
+      candidates.emplace_back();
+      try {
+        Sensor start = rim_start(lens);
+        std::vector<TargetPose> poses(views.detections.images.size());
+        bool posed = true;
+        for (size_t v = 0; v < poses.size() && posed; ++v)
+          posed = InitialTargetPose(start, input.target, views.detections.images[v], &poses[v]);
+        if (posed) {
+          FitOptions lens_options = FitOptionsFor(input, options, start, &warnings);
+          candidates.back() = FoldCandidate{std::move(start), std::move(lens_options), std::move(poses)};
+        }
+      } catch (const InputError&) {
+      }
+    }
+    const LensChoice& choice = *(record.lens_choice = ChooseLens(candidates, input.target, views.detections,
+                                                                 options.threads, options.progress));
+    const size_t chosen = std::find(choice.candidates.begin(), choice.candidates.end(), choice.chosen) - choice.candidates.begin();
+    if (choice.chosen != guess.lens_name()) {
+      FoldCandidate& lens = *candidates[chosen];
+      start_sensor = lens.start;  // `guess` refers to it
+      fit_options = lens.options;
+      views.poses = lens.initial_poses;
+    }
+    const bool scored = std::any_of(choice.held_out_rms_px.begin(), choice.held_out_rms_px.end(),
+                                    [](double rms) { return std::isfinite(rms); });
+    record.start = "rim circle, " + rim_profile + " mirror, " + choice.chosen + " lens" +
+                   (scored ? " (chosen by held-out folds)" : "");
+    if (!scored)
+      warnings.push_back({WarningCode::kLensNotChosen, "lens",
+                          "neither lens could be fitted to every held-out fold of the views (a view where no other "
+                          "reaches?); the " + choice.chosen + " lens is kept"});
+  }
   std::optional<Sensor> refit_start;  // the previous pass's fit, where the last fit started
   FitResult fit = FitSensor(guess, input.target, views.detections, views.poses, fit_options);
   // Boards of another size than the target (a decoy the detector accepted, e.g. a window
@@ -762,7 +829,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   for (size_t v = 0; v < usable.images.size(); ++v) record.per_view_outliers[usable.images[v].image] = fit.per_view_outliers[v];
   record.sigma_px = fit.sigma_px;
   record.tolerances = fit_options.tolerances;
-  record.guess_rim_radius_mm = guess.rim_radius_mm();
+  record.guess_rim_radius_mm = design_rim_mm;
   record.fitted_rim_radius_mm = fit.sensor->rim_radius_mm();
   if (fit.covariance_ok) record.covariance_names = fit.covariance_names, record.covariance = fit.covariance;
 
@@ -774,7 +841,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
       fitted_views.images.push_back(usable.images[v]), fitted_start_poses.push_back(views.poses[v]);
   const std::vector<Eigen::Vector2d> field =
       FieldPixels(*fit.sensor, FieldOfCorners(*fit.sensor, fitted_views), options.predicted_error_step_px);
-  const double rim_mm = guess.rim_radius_mm();  // n counts the start's (design) rim radii
+  const double rim_mm = design_rim_mm;
 
   // Generalisation (calib/cross_validation.h): held-out views through the fitted sensor;
   // two halves' calibrations compared where the user looks.

@@ -45,6 +45,15 @@ struct CalibrationInput {
 struct CalibrationOptions {
   std::string profile;  // mirror family to fit ("": the guess's; polynomial without a guess)
   double rim_field_deg = kDefaultRimFieldDeg;
+  // Without a guess, the lens the rim circle starts (calib/initial_sensor.h): "" or
+  // "orthographic" (a telecentric lens), "pinhole" (a perspective camera in front of the
+  // mirror; with a free-form mirror its distance m and the mirror's decenter are held,
+  // the gauges the free shape leaves: m trades with the focal length like a dolly zoom,
+  // decenter with the principal point and tilt; k1, k2 are held as for any free-form
+  // mirror), or kChooseLens: the one whose fits predict held-out folds of the views better
+  // (calib/lens_choice.h), the orthographic unless the pinhole does by more than 1 %. The
+  // folds of holdout_folds keep the lens chosen.
+  std::string lens;
   std::set<std::string> fixed;  // blocks held, by RefineOptions::Hold's names (calib/fit_options.h)
   double loss_px = 1.0;
   int max_iterations = 200;

@@ -37,6 +37,12 @@ const char* const kKnotChoiceDefinition =
     "held-out corner of every fold (poses fitted, sensor held), per corner sqrt(mean |e|^2); chosen: the fewest "
     "knots (0 first) within 1 % of the lowest, or, where the full set fitted with that count is no valid mirror, the "
     "same rule over the counts not yet tried (warning knot_count_replaced)";
+const char* const kLensChoiceDefinition =
+    "the lens an unknown mirror is seen through, chosen by held-out folds on the first detection pass's corners: the "
+    "usable views split into `folds` interleaved folds, each held out in turn while the rest are calibrated from the "
+    "rim circle through every candidate lens; held_out_rms_px over every held-out corner of every fold (poses fitted, "
+    "sensor held), per corner sqrt(mean |e|^2), null where a fold failed or a view had no pose through the lens; "
+    "chosen: the first candidate within 1 % of the lowest, the first where none scored (warning lens_not_chosen)";
 const char* const kCrossValidationDefinition =
     "the usable views split into even and odd positions, each half calibrated alone; the points distance_mm along "
     "each observed field pixel's ray through half 1 (from its reflection point), moved by the rigid motion that "
@@ -96,6 +102,16 @@ json ToJson(const CalibrationRecord& r) {
     out["folds"] = k->folds;
     out["chosen"] = k->chosen;
     out["definition"] = kKnotChoiceDefinition;
+  }
+  if (const auto& l = r.lens_choice) {
+    json& out = j["lens_choice"];
+    out["candidates"] = l->candidates;
+    out["held_out_rms_px"] = json::array();
+    for (double rms : l->held_out_rms_px) out["held_out_rms_px"].push_back(NumberOrNull(rms));
+    out["held_out_corners"] = l->held_out_corners;
+    out["folds"] = l->folds;
+    out["chosen"] = l->chosen;
+    out["definition"] = kLensChoiceDefinition;
   }
   if (const auto& h = r.holdout) {
     json& out = j["holdout"];
@@ -231,6 +247,18 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
       if (choice.held_out_rms_px.size() != choice.candidates.size())
         throw InputError(InputMessage(name, "knot_choice.held_out_rms_px", "must have one value per candidate"));
       r.knot_choice = choice;
+    }
+    if (j.contains("lens_choice")) {
+      const json& l = at("lens_choice");
+      LensChoice choice;
+      choice.candidates = l.at("candidates").get<std::vector<std::string>>();
+      for (const json& rms : l.at("held_out_rms_px")) choice.held_out_rms_px.push_back(NumberOrNan(rms));
+      choice.held_out_corners = l.at("held_out_corners").get<int>();
+      choice.folds = l.at("folds").get<int>();
+      choice.chosen = l.at("chosen").get<std::string>();
+      if (choice.held_out_rms_px.size() != choice.candidates.size())
+        throw InputError(InputMessage(name, "lens_choice.held_out_rms_px", "must have one value per candidate"));
+      r.lens_choice = choice;
     }
     if (j.contains("holdout")) {
       const json& h = at("holdout");

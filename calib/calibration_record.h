@@ -17,6 +17,7 @@
 #include "calib/cross_validation.h"
 #include "calib/design_tolerances.h"
 #include "calib/knot_choice.h"
+#include "calib/lens_choice.h"
 
 namespace omnical {
 
@@ -46,6 +47,7 @@ struct CalibrationRecord {
   std::optional<HeldOutFolds> holdout_folds;  // every view held out once (CalibrationOptions::holdout_folds)
   std::optional<BoardWarpEstimate> board_warp;  // when fitted (CalibrationOptions::board_warp)
   std::optional<KnotChoice> knot_choice;  // when chosen (CalibrationOptions::knots = kChooseKnots)
+  std::optional<LensChoice> lens_choice;  // when chosen (CalibrationOptions::lens = kChooseLens)
   // The two halves' calibrations compared (CalibrationOptions::cross_validate). The diff's
   // per-pixel vectors are kept in memory for the report's figure; the file has the summary.
   struct CrossValidationRecord {

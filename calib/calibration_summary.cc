@@ -1,6 +1,7 @@
 #include "calib/calibration_summary.h"
 
 #include <cstdarg>
+#include <cmath>
 #include <cstdio>
 
 namespace omnical {
@@ -55,6 +56,17 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
                       knots->candidates[k] > 0 ? std::to_string(knots->candidates[k]).c_str() : knots->base_profile.c_str(),
                       knots->held_out_rms_px[k], knots->candidates[k] == knots->chosen ? " (chosen)" : "");
     out += "\n";
+  }
+  if (const auto& lens = record.lens_choice) {
+    out += "lens chosen by " + std::to_string(lens->folds) + " held-out folds (" + std::to_string(lens->held_out_corners) +
+           " corners):";
+    bool scored = false;
+    for (size_t k = 0; k < lens->candidates.size(); ++k) {
+      scored |= std::isfinite(lens->held_out_rms_px[k]);
+      AppendFormatted(out, " %s: %.4f px%s", lens->candidates[k].c_str(), lens->held_out_rms_px[k],
+                      lens->candidates[k] == lens->chosen ? " (chosen)" : "");
+    }
+    out += scored ? "\n" : " (neither scored: the first kept)\n";
   }
   if (const auto& held = record.holdout)
     AppendFormatted(out, "held out: %zu views, %d corners: RMS %.4f px (training %.4f px, ratio %.2f)\n",

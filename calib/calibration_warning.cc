@@ -22,6 +22,7 @@ const char* WarningCodeName(WarningCode code) {
     case WarningCode::kPredictedErrorHigh: return "predicted_error_high";
     case WarningCode::kHeldOutWorse: return "held_out_worse";
     case WarningCode::kKnotCountReplaced: return "knot_count_replaced";
+    case WarningCode::kLensNotChosen: return "lens_not_chosen";
     case WarningCode::kBoardScreenStopped: return "board_screen_stopped";
     case WarningCode::kImageRimNotUsed: return "image_rim_not_used";
   }

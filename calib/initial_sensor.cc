@@ -56,7 +56,7 @@ Profile FitProfile(const std::vector<SagDerivatives<double>>& samples, const std
 
 // The guess's model with another mirror (target: a model of that mirror and the same lens).
 template <typename Model, typename Target>
-SensorModel WithMirror(const Model& model, Target out, const typename Target::ProfileType& mirror) {
+Target WithMirror(const Model& model, Target out, const typename Target::ProfileType& mirror) {
   out.mirror = mirror;
   out.lens = model.lens;
   out.pose = model.pose;
@@ -82,6 +82,37 @@ int NumKnots(const Sensor& sensor) {
       sensor.model());
 }
 
+// An orthographic start's mirror seen through a pinhole on its axis that sees the rim
+// theta_rad off the axis, rim_px from the principal point: the vertex R / tan(Theta) - z(R)
+// in front of it, the focal length rim_px / tan(Theta), no distortion.
+constexpr double kPinholeMirrorReach = 1.5;
+
+template <template <typename> class Profile>
+Catadioptric<double, Profile, PinholeLens> ThroughPinhole(const Catadioptric<double, Profile, OrthographicLens>& model,
+                                                          double theta_rad, double rim_px) {
+  Catadioptric<double, Profile, PinholeLens> out;
+  out.mirror = model.mirror;
+  out.rim_radius_mm = model.rim_radius_mm;
+  out.image_width_px = model.image_width_px;
+  out.image_height_px = model.image_height_px;
+  const double rim_mm = model.rim_radius_mm;
+  const double rim_sag_mm = model.mirror.template EvaluateSag<double>(rim_mm * rim_mm).z;
+  out.pose = {rim_mm / std::tan(theta_rad) - rim_sag_mm, 0.0, 0.0, 0.0, 0.0};
+  const double focal_px = rim_px / std::tan(theta_rad);
+  out.lens = {focal_px, focal_px, model.lens.cx_px, model.lens.cy_px, 0.0, 0.0};
+  // The mirror reaches past the rim circle's nominal radius, as far as its family allows
+  // (a sphere ends at its radius): the focal length and the mirror's size in mm trade
+  // off, and the fits shrank the focal length while the shape grew outwards (on
+  // rendered/ohte-sph-misaligned-near the nominal rim fell at 418 of the image rim's 500
+  // px, and a held-out view's corners beyond it had no ray).
+  for (double reach = kPinholeMirrorReach; reach > 1.0; reach -= 0.05) {
+    Catadioptric<double, Profile, PinholeLens> wider = out;
+    wider.rim_radius_mm = reach * rim_mm;
+    if (ValidateSensorModel(wider).empty()) return wider;
+  }
+  return out;
+}
+
 Sensor Validated(SensorModel model, const std::string& what) {
   const std::string problem = ValidateSensorModel(model);
   if (!problem.empty()) throw InputError(InputMessage(what, "profile", "the starting sensor is not valid: " + problem));
@@ -91,13 +122,21 @@ Sensor Validated(SensorModel model, const std::string& what) {
 }  // namespace
 
 Sensor SensorFromRimCircle(const RimCircle& rim, int image_width_px, int image_height_px, const std::string& profile,
-                           double rim_field_deg) {
+                           double rim_field_deg, const std::string& lens) {
   if (!(rim.radius_px > 0.0) || !rim.centre_px.allFinite())
     throw InputError(InputMessage("rim circle", "", "no mirror rim found in the images"));
   if (!(rim_field_deg > 10.0 && rim_field_deg < 170.0))
     throw InputError(InputMessage("rim_field_deg", "", "must lie in (10, 170) deg"));
+  if (lens != "orthographic" && lens != "pinhole")
+    throw InputError(InputMessage("lens", "", "the rim circle starts an orthographic or a pinhole lens, not '" + lens + "'"));
   const double rim_mm = kNominalRimRadiusMm;
-  const double slope = std::tan(0.5 * rim_field_deg * M_PI / 180.0);  // dz/dr at the rim
+  const bool pinhole = lens == "pinhole";
+  // The rim ray's angle from the lens axis (0 through a telecentric lens); a ray turns by
+  // twice the surface's slope angle, so the rim's slope angle is (Omega - Theta) / 2.
+  const double theta_rad = pinhole ? kNominalRimViewDeg * M_PI / 180.0 : 0.0;
+  const double slope = std::tan(0.5 * (rim_field_deg * M_PI / 180.0 - theta_rad));  // dz/dr at the rim
+  if (!(slope > 0.0))
+    throw InputError(InputMessage("rim_field_deg", "", "must exceed the pinhole's view of the rim (" + std::to_string(static_cast<int>(kNominalRimViewDeg)) + " deg)"));
   Catadioptric<double, ParaboloidProfile, OrthographicLens> base;
   base.lens = {rim.radius_px / rim_mm, rim.centre_px.x(), rim.centre_px.y()};
   base.pose = {100.0, 0.0, 0.0, 0.0, 0.0};  // m: any value in front of the lens (unobservable here)
@@ -106,24 +145,27 @@ Sensor SensorFromRimCircle(const RimCircle& rim, int image_width_px, int image_h
   base.image_height_px = image_height_px;
   // Paraboloid z = r^2 / (4 A): slope r / (2 A).
   base.mirror = {rim_mm / (2.0 * slope)};
-  if (profile == "paraboloid") return Validated(base, "rim circle");
+  // The mirror of the requested family, through the lens asked for.
+  const auto with_lens = [&](const auto& model) -> Sensor {
+    return pinhole ? Validated(ThroughPinhole(model, theta_rad, rim.radius_px), "rim circle") : Validated(model, "rim circle");
+  };
+  if (profile == "paraboloid") return with_lens(base);
   if (profile == "polynomial") {
     EvenPolynomialProfile<double> polynomial;
     polynomial.num_coefficients = kDefaultPolynomialCoefficients;
     polynomial.coefficients[0] = 1.0 / (4.0 * base.mirror.focal_distance_mm);
-    return Validated(WithMirror(base, Catadioptric<double, EvenPolynomialProfile, OrthographicLens>{}, polynomial),
-                     "rim circle");
+    return with_lens(WithMirror(base, Catadioptric<double, EvenPolynomialProfile, OrthographicLens>{}, polynomial));
   }
   if (profile == "sphere") {
     // z = A - sqrt(A^2 - r^2): slope r / sqrt(A^2 - r^2).
-    return Validated(WithMirror(base, Catadioptric<double, SphereProfile, OrthographicLens>{},
-                                SphereProfile<double>{rim_mm * std::sqrt(1.0 + 1.0 / (slope * slope))}),
-                     "rim circle");
+    return with_lens(WithMirror(base, Catadioptric<double, SphereProfile, OrthographicLens>{},
+                                SphereProfile<double>{rim_mm * std::sqrt(1.0 + 1.0 / (slope * slope))}));
   }
   // Any other fitted family that can be smooth at the rim slope: the paraboloid re-expressed.
   if (profile != "hyperboloid") {
     const std::vector<std::string> fitted = ProfileNames(false);
-    if (std::find(fitted.begin(), fitted.end(), profile) != fitted.end()) return ConvertProfile(Sensor(base), profile);
+    if (std::find(fitted.begin(), fitted.end(), profile) != fitted.end())
+      return ConvertProfile(with_lens(base), profile);
   }
   std::vector<std::string> startable;
   for (const std::string& name : ProfileNames(false))

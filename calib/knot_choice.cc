@@ -6,10 +6,9 @@
 #include <map>
 #include <vector>
 
-#include "calib/cross_validation.h"
+#include "calib/fold_scores.h"
 #include "calib/initial_sensor.h"
 #include "model/input_error.h"
-#include "model/parallel_rows.h"
 #include "model/progress.h"
 #include "model/sensor.h"
 
@@ -42,12 +41,7 @@ FitOptions WithShapeOf(FitOptions options, const Sensor& candidate) {
 }
 
 int PreferredKnotCount(const KnotChoice& choice, const std::vector<bool>& excluded) {
-  double best = HUGE_VAL;
-  for (size_t k = 0; k < choice.candidates.size(); ++k)
-    if (!excluded[k] && std::isfinite(choice.held_out_rms_px[k])) best = std::min(best, choice.held_out_rms_px[k]);
-  for (size_t k = 0; k < choice.candidates.size(); ++k)
-    if (!excluded[k] && choice.held_out_rms_px[k] <= best * (1.0 + kKnotScoreTolerance)) return static_cast<int>(k);
-  return -1;
+  return PreferredCandidate(choice.held_out_rms_px, excluded, kKnotScoreTolerance);
 }
 
 ValidKnotFit FitValidKnotCount(const KnotChoice& choice, const std::string& base_profile,
@@ -85,82 +79,20 @@ KnotChoice ChooseKnots(const Sensor& start, const std::string& base_profile, con
                        const DetectionSet& views,
                        const std::vector<TargetPose>& initial_poses, FitOptions options, const ProgressCallback& progress) {
   if (base_profile == "spline") throw InputError("knots: the base family to compare the spline with cannot be a spline");
-  const int count = static_cast<int>(views.images.size());
-  if (count < 4)
-    throw InputError("knots: choosing the count needs >= 4 usable views (held-out folds leave >= 3 to fit); " +
-                     std::to_string(count) + " given");
   KnotChoice choice;
   choice.base_profile = base_profile;
   choice.candidates = kKnotCandidates;
-  // Five folds where the views allow: each training set keeps 4/5 of the views, close to
-  // the full fit the choice is for.
-  choice.folds = std::min(5, count);
-  options.compute_covariance = false;
-  options.progress = nullptr;
-  const int folds = choice.folds, jobs = static_cast<int>(choice.candidates.size()) * folds;
-  ProgressReporter reporter(progress, "knots", jobs);
-  std::vector<Sensor> candidates;
-  for (int knots : choice.candidates)
-    candidates.push_back(knots > 0 ? ConvertProfile(start, "spline", knots) : ConvertProfile(start, base_profile));
-  // Every (count, fold) fit is independent: they share the threads, one fit each (a fit's
-  // result is the same for any thread count, so the choice is too).
-  struct FoldScore {
-    bool failed = false;
-    double square = 0.0;
-    int corners = 0;
-  };
-  std::vector<FoldScore> scores(jobs);
-  const int workers = std::max(1, options.threads);
-  options.threads = 1;
-  // Callbacks a caller gave the solver would be called from several fits at once.
-  options.solver.callbacks.clear();
-  // The most knots (the slowest fits) first, so no long fit starts last.
-  ParallelRows(jobs, workers, [&](int reversed) {
-    const int job = jobs - 1 - reversed;
-    if (reporter.cancelled()) return;
-    const Sensor& candidate = candidates[job / folds];
-    const int fold = job % folds;
-    DetectionSet training = views, held = views;
-    training.images.clear(), held.images.clear();
-    std::vector<TargetPose> poses;
-    for (int v = 0; v < count; ++v) {
-      if (v % folds == fold) {
-        held.images.push_back(views.images[v]);
-      } else {
-        training.images.push_back(views.images[v]);
-        poses.push_back(initial_poses[v]);
-      }
-    }
-    FoldScore& score = scores[job];
-    const FitResult fit = FitSensor(candidate, target, training, poses, WithShapeOf(options, candidate));
-    if (fit.sensor) {
-      FitOptions held_options = WithShapeOf(options, candidate);
-      if (fit.board_warp) held_options.board_warp = fit.board_warp->warp;
-      const HeldOutViews result = EvaluateHeldOutViews(*fit.sensor, target, held, held_options);
-      // A view whose pose cannot be fitted through this sensor counts against the count
-      // as failing: its corners are not in the score, so a score without them would flatter.
-      score.failed = !result.not_evaluated.empty() || !(result.corners > 0);
-      score.square = result.rms_px * result.rms_px * result.corners;
-      score.corners = result.corners;
-    } else {
-      score.failed = true;
-    }
-    reporter.Advance();
-  });
-  reporter.ThrowIfCancelled();
-  for (size_t k = 0; k < choice.candidates.size(); ++k) {
-    double square = 0.0;
-    int corners = 0;
-    bool failed = false;
-    for (int fold = 0; fold < folds; ++fold) {
-      const FoldScore& score = scores[k * folds + fold];
-      failed |= score.failed;
-      square += score.square;
-      corners += score.corners;
-    }
-    choice.held_out_rms_px.push_back(failed ? NAN : std::sqrt(square / corners));
-    if (!failed) choice.held_out_corners = corners;
+  // The most knots (the slowest fits) last: scored first, so no long fit starts last.
+  std::vector<FoldCandidate> candidates;
+  for (int knots : choice.candidates) {
+    Sensor sensor = knots > 0 ? ConvertProfile(start, "spline", knots) : ConvertProfile(start, base_profile);
+    FitOptions sensor_options = WithShapeOf(options, sensor);
+    candidates.push_back({std::move(sensor), std::move(sensor_options), initial_poses});
   }
+  const FoldScores scores = ScoreByHeldOutFolds(candidates, target, views, options.threads, "knots", "knots", progress);
+  choice.held_out_rms_px = scores.held_out_rms_px;
+  choice.held_out_corners = scores.held_out_corners;
+  choice.folds = scores.folds;
   const int preferred = PreferredKnotCount(choice, std::vector<bool>(choice.candidates.size(), false));
   if (preferred < 0) throw InputError("knots: no knot count could be fitted to every fold of the views");
   choice.chosen = choice.candidates[preferred];

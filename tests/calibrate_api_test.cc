@@ -120,6 +120,14 @@ TEST(CalibrateApi, RecordRoundTripsThroughCalibrationJson) {
   EXPECT_EQ(chosen_back.knot_choice->chosen, 4);
   EXPECT_TRUE(std::isnan(chosen_back.knot_choice->held_out_rms_px[2]));
   EXPECT_EQ(CalibrationJsonText(chosen_back), CalibrationJsonText(chosen));
+  // A lens choice, the pinhole failed (a view without a start pose through it).
+  chosen.lens_choice = LensChoice{kLensCandidates, {0.38, NAN}, 480, 5, "orthographic"};
+  const CalibrationRecord lens_back = ParseCalibrationJson(CalibrationJsonText(chosen), "memory");
+  ASSERT_TRUE(lens_back.lens_choice.has_value());
+  EXPECT_EQ(lens_back.lens_choice->chosen, "orthographic");
+  EXPECT_EQ(lens_back.lens_choice->candidates, kLensCandidates);
+  EXPECT_TRUE(std::isnan(lens_back.lens_choice->held_out_rms_px[1]));
+  EXPECT_EQ(CalibrationJsonText(lens_back), CalibrationJsonText(chosen));
 }
 
 // A view whose corners are all wrong is left out: its RMS is written as null and must read

@@ -26,15 +26,20 @@ TEST(SensorFromRimCircle, PutsTheRimRayWhereAsked) {
   RimCircle rim;
   rim.centre_px = Eigen::Vector2d(641.0, 521.5);
   rim.radius_px = 352.0;
-  for (const std::string profile : {"paraboloid", "polynomial", "sphere", "even_asphere"})
-    for (double field_deg : {95.0, 105.0, 120.0}) {
-      const Sensor sensor = SensorFromRimCircle(rim, 1280, 1024, profile, field_deg);
-      EXPECT_STREQ(sensor.profile_name(), profile.c_str());
-      EXPECT_STREQ(sensor.lens_name(), "orthographic");
-      EXPECT_NEAR(OmegaDeg(sensor, rim.centre_px + Eigen::Vector2d(0.999 * rim.radius_px, 0.0)), field_deg, 0.5) << profile;
-      EXPECT_NEAR(OmegaDeg(sensor, rim.centre_px + Eigen::Vector2d(0.0, -0.999 * rim.radius_px)), field_deg, 0.5) << profile;
-      EXPECT_LT(OmegaDeg(sensor, rim.centre_px + Eigen::Vector2d(0.5, 0.0)), 1.0) << profile;
-    }
+  // Through a pinhole (a perspective camera in front of the mirror) the rim circle is the
+  // nominal rim's image, the mirror reaching beyond it.
+  for (const std::string lens : {"orthographic", "pinhole"})
+    for (const std::string profile : {"paraboloid", "polynomial", "sphere", "even_asphere"})
+      for (double field_deg : {95.0, 105.0, 120.0}) {
+        const Sensor sensor = SensorFromRimCircle(rim, 1280, 1024, profile, field_deg, lens);
+        EXPECT_STREQ(sensor.profile_name(), profile.c_str());
+        EXPECT_STREQ(sensor.lens_name(), lens.c_str());
+        EXPECT_NEAR(OmegaDeg(sensor, rim.centre_px + Eigen::Vector2d(0.999 * rim.radius_px, 0.0)), field_deg, 0.5)
+            << profile << " " << lens;
+        EXPECT_NEAR(OmegaDeg(sensor, rim.centre_px + Eigen::Vector2d(0.0, -0.999 * rim.radius_px)), field_deg, 0.5)
+            << profile << " " << lens;
+        EXPECT_LT(OmegaDeg(sensor, rim.centre_px + Eigen::Vector2d(0.5, 0.0)), 1.0) << profile << " " << lens;
+      }
 }
 
 TEST(SensorFromRimCircle, RefusesWhatTheRimCannotStart) {
@@ -43,6 +48,9 @@ TEST(SensorFromRimCircle, RefusesWhatTheRimCannotStart) {
   rim.radius_px = 350.0;
   EXPECT_THROW(SensorFromRimCircle(rim, 1280, 1024, "hyperboloid"), InputError);
   EXPECT_THROW(SensorFromRimCircle(rim, 1280, 1024, "paraboloid", 179.0), InputError);
+  EXPECT_THROW(SensorFromRimCircle(rim, 1280, 1024, "polynomial", 105.0, "fisheye"), InputError);
+  // A pinhole sees the rim 12 deg off its axis: a rim ray at 11 deg would need a concave rim.
+  EXPECT_THROW(SensorFromRimCircle(rim, 1280, 1024, "polynomial", 11.0, "pinhole"), InputError);
   rim.radius_px = 0.0;
   EXPECT_THROW(SensorFromRimCircle(rim, 1280, 1024, "polynomial"), InputError);
 }

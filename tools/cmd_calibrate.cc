@@ -34,7 +34,7 @@ const FlagTable kFlags = {{"fixed", "--fix"}, {"robust_loss_px", "--loss-px"}, {
                           {"distances_n", "--distance-n"}, {"max_predicted_error_px", "--max-predicted-error-px"},
                           {"holdout_views", "--holdout"}, {"holdout", "--holdout"}, {"holdout_folds", "--holdout-folds"}, {"cross_validate", "--cross-validate"},
                           {"cross_validation_distance_mm", "--cross-validate-distance-mm"}, {"knots", "--knots"},
-                          {"checkerboard_edges", "--checkerboard-edges"}};
+                          {"lens", "--lens"}, {"checkerboard_edges", "--checkerboard-edges"}};
 
 void RunCalibrate(CalibrateFlags options, const Context& context) {
   CalibrationInput input;
@@ -90,7 +90,7 @@ Command CalibrateCommand() {
             sub.add_option("--detections", options->detections_path, "Detections (JSON, from omnical detect)");
             sub.add_option("--sensor", options->sensor_path,
                            "Sensor guess (YAML): nominal design values. Without it the fit starts from the mirror's "
-                           "rim circle in the images (orthographic lens, scale held)");
+                           "rim circle in the images (orthographic lens, scale held; see --lens)");
             sub.add_option("--profile", library.profile,
                            "Mirror family to fit: " + JoinChoices(ProfileNames(false)) +
                                " (polynomial by default without a guess; a hyperboloid needs --sensor); a guess of "

@@ -21,6 +21,10 @@ void AddGeneralisationFlags(CLI::App& sub, CalibrationOptions* library) {
                  "Distance of the cross-validation comparison (mm from the reflection point; default: the first "
                  "--distance-mm / --distance-n, else 2000)")
       ->check(kPositive);
+  sub.add_option("--lens", library->lens, "Without a guess: the lens the rim circle starts: orthographic (default), "
+                 "pinhole (a perspective camera; with a free-form mirror m and decenter held as gauges) or auto: the "
+                 "one predicting held-out folds better (calibration.json lens_choice)")
+      ->check(CLI::IsMember({"orthographic", "pinhole", "auto"}));
   sub.add_flag("--leave-one-out", library->leave_one_out,
                "Also fit without each image in turn; calibration.json gets each parameter's spread");
 }

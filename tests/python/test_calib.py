@@ -586,6 +586,14 @@ def test_bad_option_values_name_the_argument(runs, tmp_path):
         omnical.calibrate(TARGET, IMAGES, detections=detections)
     with pytest.raises(omnical.InputError, match="^guess: expected an omnical.Sensor"):
         omnical.calibrate(TARGET, detections=detections, guess=1)
+    # The lens the rim circle starts: only without a guess, one of three.
+    with pytest.raises(omnical.InputError, match="^lens: the rim circle starts an orthographic or a pinhole lens"):
+        omnical.calibrate(TARGET, detections=detections, lens="fisheye")
+    with_guess = cli_error(run_cli("calibrate", "--target", TARGET, "--detections", detections, "--sensor", GUESS,
+                                   "--lens", "pinhole", "--out", tmp_path / "lens"))
+    with pytest.raises(omnical.InputError) as caught:
+        omnical.calibrate(TARGET, detections=detections, guess=GUESS, lens="pinhole")
+    assert str(caught.value) == with_guess and ": lens: the guess has its lens (pinhole)" in with_guess
 
 
 # --- target ------------------------------------------------------------------------------

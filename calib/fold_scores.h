@@ -1,0 +1,47 @@
+// How well each of several candidate models predicts views it was not fitted to: K-fold
+// over the views, fold f holding out the views at positions f, f + K, ... (interleaved,
+// as the two halves are: a hand-held set drifts); each candidate is calibrated on the
+// rest and the held-out views' poses fitted with its sensor held (EvaluateHeldOutViews).
+// The score is the RMS over every held-out corner of every fold, per corner
+// sqrt(mean |e|^2). Used to choose a spline's knot count (calib/knot_choice.h) and the
+// lens of an unknown mirror (calib/lens_choice.h), never by training RMS, which only falls
+// as parameters are added.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "calib/bundle_fit.h"
+#include "calib/detections.h"
+#include "calib/target.h"
+#include "model/progress.h"
+#include "model/sensor.h"
+
+namespace omnical {
+
+struct FoldCandidate {
+  Sensor start;
+  FitOptions options;  // its fit's (no covariance is computed here)
+  std::vector<TargetPose> initial_poses;  // per view
+};
+
+struct FoldScores {
+  std::vector<double> held_out_rms_px;  // per candidate, NaN when a fold failed to fit
+  int held_out_corners = 0;             // per candidate (the same corners for all)
+  int folds = 0;
+};
+
+// Five folds where the views allow (each training set keeps 4/5 of them, close to the
+// full fit the choice is for). The candidates' fold fits share `threads`, one fit per
+// thread (a fit's result is the same for any thread count, so the scores are too); the
+// last candidates' first (list the slowest last). Progress as stage `stage`. Throws
+// InputError "field: ..." with fewer than 4 views.
+FoldScores ScoreByHeldOutFolds(const std::vector<FoldCandidate>& candidates, const CalibrationTarget& target,
+                               const DetectionSet& views, int threads, const std::string& stage,
+                               const std::string& field, const ProgressCallback& progress);
+
+// The index of the first candidate not excluded whose score is within `tolerance` of the
+// lowest of them (list the simplest first); -1 when none has a score.
+int PreferredCandidate(const std::vector<double>& held_out_rms_px, const std::vector<bool>& excluded, double tolerance);
+
+}  // namespace omnical
