@@ -248,6 +248,16 @@ def test_load_calibration_round_trip(runs, tmp_path):
     assert record.start == result.start
     with pytest.raises(omnical.InputError, match="nowhere.json"):
         omnical.load_calibration(tmp_path / "nowhere.json")
+    # A lens choice (written by --lens auto; its numbers set here) reads back as the dict,
+    # a failed candidate's null as NaN.
+    data = json.loads(path.read_text())
+    data["lens_choice"] = {"candidates": ["orthographic", "pinhole"], "held_out_rms_px": [2.5, None],
+                           "held_out_corners": 1100, "folds": 5, "chosen": "orthographic"}
+    (tmp_path / "lens.json").write_text(json.dumps(data))
+    lens = omnical.load_calibration(tmp_path / "lens.json").lens_choice
+    assert lens["candidates"] == ["orthographic", "pinhole"] and lens["chosen"] == "orthographic"
+    assert lens["held_out_rms_px"][0] == 2.5 and math.isnan(lens["held_out_rms_px"][1]) and lens["folds"] == 5
+    assert record.lens_choice is None
 
 
 def test_calibrate_from_detections_without_guess_with_leave_one_out(runs, tmp_path):
