@@ -14,7 +14,8 @@ FoldScores ScoreByHeldOutFolds(const std::vector<FoldCandidate>& candidates, con
                                const std::string& field, const ProgressCallback& progress) {
   const int count = static_cast<int>(views.images.size());
   if (count < 4)
-    throw InputError(field + ": choosing by held-out folds needs >= 4 usable views (held-out folds leave >= 3 to fit); " +
+    throw InputError(field +
+                     ": choosing by held-out folds needs >= 4 usable views (held-out folds leave >= 3 to fit); " +
                      std::to_string(count) + " given");
   FoldScores result;
   result.folds = std::min(5, count);
@@ -81,7 +82,8 @@ FoldScores ScoreByHeldOutFolds(const std::vector<FoldCandidate>& candidates, con
   return result;
 }
 
-int PreferredCandidate(const std::vector<double>& held_out_rms_px, const std::vector<bool>& excluded, double tolerance) {
+int PreferredCandidate(const std::vector<double>& held_out_rms_px, const std::vector<bool>& excluded,
+                       double tolerance) {
   double best = HUGE_VAL;
   for (size_t k = 0; k < held_out_rms_px.size(); ++k)
     if (!excluded[k] && std::isfinite(held_out_rms_px[k])) best = std::min(best, held_out_rms_px[k]);
@@ -91,4 +93,3 @@ int PreferredCandidate(const std::vector<double>& held_out_rms_px, const std::ve
 }
 
 }  // namespace omnical
-

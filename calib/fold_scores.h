@@ -21,7 +21,7 @@ namespace omnical {
 
 struct FoldCandidate {
   Sensor start;
-  FitOptions options;  // its fit's (no covariance is computed here)
+  FitOptions options;                     // its fit's (no covariance is computed here)
   std::vector<TargetPose> initial_poses;  // per view
 };
 

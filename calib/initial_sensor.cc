@@ -82,11 +82,12 @@ int NumKnots(const Sensor& sensor) {
       sensor.model());
 }
 
+// How far past the nominal rim a pinhole start's mirror reaches (ThroughPinhole).
+constexpr double kPinholeMirrorReach = 1.5;
+
 // An orthographic start's mirror seen through a pinhole on its axis that sees the rim
 // theta_rad off the axis, rim_px from the principal point: the vertex R / tan(Theta) - z(R)
 // in front of it, the focal length rim_px / tan(Theta), no distortion.
-constexpr double kPinholeMirrorReach = 1.5;
-
 template <template <typename> class Profile>
 Catadioptric<double, Profile, PinholeLens> ThroughPinhole(const Catadioptric<double, Profile, OrthographicLens>& model,
                                                           double theta_rad, double rim_px) {
@@ -128,7 +129,8 @@ Sensor SensorFromRimCircle(const RimCircle& rim, int image_width_px, int image_h
   if (!(rim_field_deg > 10.0 && rim_field_deg < 170.0))
     throw InputError(InputMessage("rim_field_deg", "", "must lie in (10, 170) deg"));
   if (lens != "orthographic" && lens != "pinhole")
-    throw InputError(InputMessage("lens", "", "the rim circle starts an orthographic or a pinhole lens, not '" + lens + "'"));
+    throw InputError(
+        InputMessage("lens", "", "the rim circle starts an orthographic or a pinhole lens, not '" + lens + "'"));
   const double rim_mm = kNominalRimRadiusMm;
   const bool pinhole = lens == "pinhole";
   // The rim ray's angle from the lens axis (0 through a telecentric lens); a ray turns by
@@ -136,7 +138,9 @@ Sensor SensorFromRimCircle(const RimCircle& rim, int image_width_px, int image_h
   const double theta_rad = pinhole ? kNominalRimViewDeg * M_PI / 180.0 : 0.0;
   const double slope = std::tan(0.5 * (rim_field_deg * M_PI / 180.0 - theta_rad));  // dz/dr at the rim
   if (!(slope > 0.0))
-    throw InputError(InputMessage("rim_field_deg", "", "must exceed the pinhole's view of the rim (" + std::to_string(static_cast<int>(kNominalRimViewDeg)) + " deg)"));
+    throw InputError(InputMessage("rim_field_deg", "",
+                                  "must exceed the pinhole's view of the rim (" +
+                                      std::to_string(static_cast<int>(kNominalRimViewDeg)) + " deg)"));
   Catadioptric<double, ParaboloidProfile, OrthographicLens> base;
   base.lens = {rim.radius_px / rim_mm, rim.centre_px.x(), rim.centre_px.y()};
   base.pose = {100.0, 0.0, 0.0, 0.0, 0.0};  // m: any value in front of the lens (unobservable here)
@@ -147,7 +151,8 @@ Sensor SensorFromRimCircle(const RimCircle& rim, int image_width_px, int image_h
   base.mirror = {rim_mm / (2.0 * slope)};
   // The mirror of the requested family, through the lens asked for.
   const auto with_lens = [&](const auto& model) -> Sensor {
-    return pinhole ? Validated(ThroughPinhole(model, theta_rad, rim.radius_px), "rim circle") : Validated(model, "rim circle");
+    if (pinhole) return Validated(ThroughPinhole(model, theta_rad, rim.radius_px), "rim circle");
+    return Validated(model, "rim circle");
   };
   if (profile == "paraboloid") return with_lens(base);
   if (profile == "polynomial") {

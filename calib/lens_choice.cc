@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-
 namespace omnical {
 
 LensChoice ChooseLens(const std::vector<std::optional<FoldCandidate>>& candidates, const CalibrationTarget& target,

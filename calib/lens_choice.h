@@ -16,9 +16,10 @@ namespace omnical {
 
 // CalibrationOptions::lens: choose here.
 inline constexpr const char* kChooseLens = "auto";
-// The simplest first: the orthographic lens has 3 parameters, a pinhole 6 (k1, k2 held
-// with a free shape), and the pinhole is kept only where it predicts better by more than
-// kLensScoreTolerance (the knots' parsimony rule, calib/knot_choice.h).
+// The simplest first: the orthographic lens fits its principal point (its scale held), a
+// pinhole also its focal lengths (k1, k2 held with a free shape); the pinhole is kept only
+// where it predicts better by more than kLensScoreTolerance (the knots' parsimony rule,
+// calib/knot_choice.h).
 inline const std::vector<std::string> kLensCandidates = {"orthographic", "pinhole"};
 constexpr double kLensScoreTolerance = 0.01;
 
