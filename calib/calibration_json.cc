@@ -50,6 +50,32 @@ const char* const kCrossValidationDefinition =
 
 json NumberOrNull(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 double NumberOrNan(const json& value) { return value.is_null() ? NAN : value.get<double>(); }
+
+// What every choice by held-out folds records (KnotChoice, LensChoice: calib/fold_scores.h).
+template <typename Choice>
+json FoldChoiceJson(const Choice& choice, const char* definition) {
+  json out;
+  out["candidates"] = choice.candidates;
+  out["held_out_rms_px"] = json::array();
+  for (double rms : choice.held_out_rms_px) out["held_out_rms_px"].push_back(NumberOrNull(rms));
+  out["held_out_corners"] = choice.held_out_corners;
+  out["folds"] = choice.folds;
+  out["chosen"] = choice.chosen;
+  out["definition"] = definition;
+  return out;
+}
+template <typename Choice>
+Choice FoldChoiceFromJson(const json& in, const std::string& name, const std::string& key) {
+  Choice choice;
+  choice.candidates = in.at("candidates").get<decltype(choice.candidates)>();
+  for (const json& rms : in.at("held_out_rms_px")) choice.held_out_rms_px.push_back(NumberOrNan(rms));
+  choice.held_out_corners = in.at("held_out_corners").get<int>();
+  choice.folds = in.at("folds").get<int>();
+  choice.chosen = in.at("chosen").get<decltype(choice.chosen)>();
+  if (choice.held_out_rms_px.size() != choice.candidates.size())
+    throw InputError(InputMessage(name, key + ".held_out_rms_px", "must have one value per candidate"));
+  return choice;
+}
 json DistanceOrInfinity(double value, bool infinite) { return infinite ? json("infinity") : json(value); }
 double ReadDistance(const json& value, double infinity) {
   return value.is_string() && value.get<std::string>() == "infinity" ? infinity : value.get<double>();
@@ -93,26 +119,10 @@ json ToJson(const CalibrationRecord& r) {
     j["board_warp"] = {{"x_mm", w->warp.x_mm}, {"y_mm", w->warp.y_mm}, {"std_x_mm", NumberOrNull(w->std_x_mm)},
                        {"std_y_mm", NumberOrNull(w->std_y_mm)}, {"definition", kBoardWarpDefinition}};
   if (const auto& k = r.knot_choice) {
-    json& out = j["knot_choice"];
+    json& out = j["knot_choice"] = FoldChoiceJson(*k, kKnotChoiceDefinition);
     out["base_profile"] = k->base_profile;
-    out["candidates"] = k->candidates;
-    out["held_out_rms_px"] = json::array();
-    for (double rms : k->held_out_rms_px) out["held_out_rms_px"].push_back(NumberOrNull(rms));
-    out["held_out_corners"] = k->held_out_corners;
-    out["folds"] = k->folds;
-    out["chosen"] = k->chosen;
-    out["definition"] = kKnotChoiceDefinition;
   }
-  if (const auto& l = r.lens_choice) {
-    json& out = j["lens_choice"];
-    out["candidates"] = l->candidates;
-    out["held_out_rms_px"] = json::array();
-    for (double rms : l->held_out_rms_px) out["held_out_rms_px"].push_back(NumberOrNull(rms));
-    out["held_out_corners"] = l->held_out_corners;
-    out["folds"] = l->folds;
-    out["chosen"] = l->chosen;
-    out["definition"] = kLensChoiceDefinition;
-  }
+  if (const auto& l = r.lens_choice) j["lens_choice"] = FoldChoiceJson(*l, kLensChoiceDefinition);
   if (const auto& h = r.holdout) {
     json& out = j["holdout"];
     out["views"] = h->images;
@@ -237,29 +247,10 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
     }
     if (j.contains("knot_choice")) {
       const json& k = at("knot_choice");
-      KnotChoice choice;
-      choice.base_profile = k.at("base_profile").get<std::string>();
-      choice.candidates = k.at("candidates").get<std::vector<int>>();
-      for (const json& rms : k.at("held_out_rms_px")) choice.held_out_rms_px.push_back(NumberOrNan(rms));
-      choice.held_out_corners = k.at("held_out_corners").get<int>();
-      choice.folds = k.at("folds").get<int>();
-      choice.chosen = k.at("chosen").get<int>();
-      if (choice.held_out_rms_px.size() != choice.candidates.size())
-        throw InputError(InputMessage(name, "knot_choice.held_out_rms_px", "must have one value per candidate"));
-      r.knot_choice = choice;
+      r.knot_choice = FoldChoiceFromJson<KnotChoice>(k, name, "knot_choice");
+      r.knot_choice->base_profile = k.at("base_profile").get<std::string>();
     }
-    if (j.contains("lens_choice")) {
-      const json& l = at("lens_choice");
-      LensChoice choice;
-      choice.candidates = l.at("candidates").get<std::vector<std::string>>();
-      for (const json& rms : l.at("held_out_rms_px")) choice.held_out_rms_px.push_back(NumberOrNan(rms));
-      choice.held_out_corners = l.at("held_out_corners").get<int>();
-      choice.folds = l.at("folds").get<int>();
-      choice.chosen = l.at("chosen").get<std::string>();
-      if (choice.held_out_rms_px.size() != choice.candidates.size())
-        throw InputError(InputMessage(name, "lens_choice.held_out_rms_px", "must have one value per candidate"));
-      r.lens_choice = choice;
-    }
+    if (j.contains("lens_choice")) r.lens_choice = FoldChoiceFromJson<LensChoice>(at("lens_choice"), name, "lens_choice");
     if (j.contains("holdout")) {
       const json& h = at("holdout");
       HeldOutViews held;
