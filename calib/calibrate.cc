@@ -278,6 +278,7 @@ FitOptions FitOptionsFor(const CalibrationInput& input, const CalibrationOptions
   // sphere's or a paraboloid's are observable, as with a guess.
   const bool free_form = std::visit([](const auto& model) { return HasFreeFormTerms(model.mirror); }, start.model());
   if (!input.guess && std::string(start.lens_name()) == "pinhole" && free_form) fit.refine.m = fit.refine.decenter = false;
+  if (options.tangential == kTangentialOn) fit.refine.tangential = true;
   if (const std::string why = fit.refine.Hold(options.fixed); !why.empty()) throw InputError(why);
   fit.robust_loss_px = options.loss_px;
   fit.fit_board_warp = options.board_warp;
@@ -344,6 +345,10 @@ std::string CalibrationOptions::Check() const {
   if (!(rim_field_deg >= 10.0 && rim_field_deg <= 170.0)) return "rim_field_deg: must lie in 10-170 deg";
   if (!lens.empty() && lens != "orthographic" && lens != "pinhole" && lens != kChooseLens)
     return "lens: the rim circle starts an orthographic or a pinhole lens, or 'auto' (got '" + lens + "')";
+  if (!tangential.empty() && tangential != kTangentialOff && tangential != kTangentialOn && tangential != kChooseTangential)
+    return "tangential: off, on or auto (got '" + tangential + "')";
+  if ((tangential == kTangentialOn || tangential == kChooseTangential) && (fixed.count("tangential") || fixed.count("lens")))
+    return "tangential/fixed: tangential " + tangential + " fits p1, p2, which fixed holds";
   if (!(loss_px >= 0.0 && std::isfinite(loss_px))) return "loss_px: must be >= 0 and finite";
   if (max_iterations < 1) return "max_iterations: must be >= 1";
   // Pass 2 re-detects through the first fit; an aprilgrid's later passes through the last.
@@ -403,6 +408,9 @@ CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const
   // The lens the full set chose (choosing again would be 10 fits more per fold, and a
   // fold could judge another lens than the calibration written).
   if (const auto& lens = result.record.lens_choice) fold_options.lens = lens->chosen;
+  if (const auto& tangential = result.record.tangential_choice)  // the same for the tangential terms
+    fold_options.tangential = tangential->chosen == kTangentialCandidates[1] ? kTangentialOn : kTangentialOff;
+  if (fold_options.lens == "orthographic") fold_options.tangential = kTangentialOff;  // which it has none of
   std::vector<CalibrationWarning> warnings;  // the folds' own, added to the full set's below
   HeldOutFolds folds;
   folds.views_per_fold = options.holdout_folds;
@@ -453,6 +461,17 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   if (input.guess && !options.lens.empty())
     throw InputError(InputMessage(input.guess_name, "lens", "the guess has its lens (" + std::string(input.guess->lens_name()) +
                                                                 "): lens chooses the rim circle's start, without a guess"));
+  // p1, p2 are a pinhole's: refused where the lens is known to be orthographic (with
+  // lens auto an orthographic choice leaves them out).
+  const std::string known_lens = input.guess                             ? input.guess->lens_name()
+                                 : options.lens.empty()                  ? "orthographic"
+                                 : options.lens == kChooseLens           ? ""
+                                                                         : options.lens;
+  if (!options.tangential.empty() && options.tangential != kTangentialOff && known_lens == "orthographic") {
+    const std::string why = "the orthographic lens has no tangential distortion (p1, p2 are a pinhole's)";
+    throw InputError(input.guess ? InputMessage(input.guess_name, "tangential", why)
+                                 : "tangential: " + why + "; give lens pinhole or auto");
+  }
   // Said, not ignored: how a checkerboard's corners are refined is a step of the second
   // detection pass over its images (unset: edges wherever that applies).
   const bool refinement_asked = options.checkerboard_edges.has_value();
@@ -579,8 +598,9 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
       } catch (const InputError&) {
       }
     }
-    const LensChoice& choice = *(record.lens_choice = ChooseLens(candidates, input.target, views.detections,
-                                                                 options.threads, options.progress));
+    const NamedChoice& choice =
+        *(record.lens_choice = ChooseByHeldOutFolds(kLensCandidates, candidates, kLensScoreTolerance, input.target,
+                                                    views.detections, options.threads, "lens", options.progress));
     const size_t chosen = std::find(choice.candidates.begin(), choice.candidates.end(), choice.chosen) - choice.candidates.begin();
     if (choice.chosen != guess.lens_name()) {
       FoldCandidate& lens = *candidates[chosen];
@@ -596,6 +616,32 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
       warnings.push_back({WarningCode::kLensNotChosen, "lens",
                           "neither lens could be fitted to every held-out fold of the views (a view where no other "
                           "reaches?); the " + choice.chosen + " lens is kept"});
+    if (!options.tangential.empty() && options.tangential != kTangentialOff && choice.chosen == "orthographic")
+      warnings.push_back({WarningCode::kTangentialNotFitted, "tangential",
+                          "tangential " + options.tangential + ": the orthographic lens was chosen, which has no "
+                          "tangential distortion; p1, p2 are not fitted"});
+  }
+  // A pinhole's tangential terms by held-out folds, from the start the lens choice left
+  // (calib/tangential_choice.h). Held, that start is the lens choice's pinhole candidate:
+  // its score is reused (5 fits fewer).
+  if (options.tangential == kChooseTangential && std::string(guess.lens_name()) == "pinhole") {
+    FitOptions fitted = fit_options;
+    fitted.refine.tangential = true;
+    std::optional<KnownScore> held_score;
+    if (const auto& lens = record.lens_choice)
+      held_score = KnownScore{lens->held_out_rms_px[1], lens->held_out_corners};  // kLensCandidates[1], the pinhole
+    const NamedChoice& choice = *(record.tangential_choice = ChooseByHeldOutFolds(
+                                      kTangentialCandidates,
+                                      {FoldCandidate{guess, fit_options, views.poses},
+                                       FoldCandidate{guess, std::move(fitted), views.poses}},
+                                      kTangentialScoreTolerance, input.target, views.detections, options.threads,
+                                      "tangential", options.progress, {held_score, std::nullopt}));
+    fit_options.refine.tangential = choice.chosen == kTangentialCandidates[1];
+    if (std::none_of(choice.held_out_rms_px.begin(), choice.held_out_rms_px.end(),
+                     [](double rms) { return std::isfinite(rms); }))
+      warnings.push_back({WarningCode::kTangentialNotFitted, "tangential",
+                          "neither held nor fitted p1, p2 could be fitted to every held-out fold of the views; they "
+                          "are held"});
   }
   std::optional<Sensor> refit_start;  // the previous pass's fit, where the last fit started
   FitResult fit = FitSensor(guess, input.target, views.detections, views.poses, fit_options);

@@ -22,6 +22,7 @@
 #include "calib/initial_sensor.h"
 #include "calib/knot_choice.h"
 #include "calib/predicted_error.h"
+#include "calib/tangential_choice.h"
 #include "calib/target.h"
 #include "model/progress.h"
 #include "model/sensor.h"
@@ -54,6 +55,12 @@ struct CalibrationOptions {
   // (calib/lens_choice.h), the orthographic unless the pinhole does by more than 1 %. The
   // folds of holdout_folds keep the lens chosen.
   std::string lens;
+  // A pinhole's tangential distortion p1, p2 (calib/tangential_choice.h): "" or "off" held
+  // at the start's values, "on" fitted, or kChooseTangential: fitted where that predicts
+  // held-out folds of the views better by more than 1 %. Refused with an orthographic lens;
+  // with lens auto, applied only if the pinhole is chosen. The folds of holdout_folds keep
+  // the choice.
+  std::string tangential;
   std::set<std::string> fixed;  // blocks held, by RefineOptions::Hold's names (calib/fit_options.h)
   double loss_px = 1.0;
   int max_iterations = 200;

@@ -43,6 +43,12 @@ const char* const kLensChoiceDefinition =
     "rim circle through every candidate lens; held_out_rms_px over every held-out corner of every fold (poses fitted, "
     "sensor held), per corner sqrt(mean |e|^2), null where a fold failed or a view had no pose through the lens; "
     "chosen: the first candidate within 1 % of the lowest, the first where none scored (warning lens_not_chosen)";
+const char* const kTangentialChoiceDefinition =
+    "whether the pinhole's tangential distortion p1, p2 is fitted (candidate fitted) or held at the start's values "
+    "(held), chosen by held-out folds on the first detection pass's corners: the usable views split into `folds` "
+    "interleaved folds, each held out in turn while the rest are calibrated both ways; held_out_rms_px over every "
+    "held-out corner of every fold (poses fitted, sensor held), per corner sqrt(mean |e|^2), null where a fold "
+    "failed; chosen: the first candidate within 1 % of the lowest, the first where none scored";
 const char* const kCrossValidationDefinition =
     "the usable views split into even and odd positions, each half calibrated alone; the points distance_mm along "
     "each observed field pixel's ray through half 1 (from its reflection point), moved by the rigid motion that "
@@ -51,7 +57,7 @@ const char* const kCrossValidationDefinition =
 json NumberOrNull(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 double NumberOrNan(const json& value) { return value.is_null() ? NAN : value.get<double>(); }
 
-// What every choice by held-out folds records (KnotChoice, LensChoice: calib/fold_scores.h).
+// What every choice by held-out folds records (KnotChoice, NamedChoice: calib/fold_scores.h).
 template <typename Choice>
 json FoldChoiceJson(const Choice& choice, const char* definition) {
   json out;
@@ -123,6 +129,7 @@ json ToJson(const CalibrationRecord& r) {
     out["base_profile"] = k->base_profile;
   }
   if (const auto& l = r.lens_choice) j["lens_choice"] = FoldChoiceJson(*l, kLensChoiceDefinition);
+  if (const auto& t = r.tangential_choice) j["tangential_choice"] = FoldChoiceJson(*t, kTangentialChoiceDefinition);
   if (const auto& h = r.holdout) {
     json& out = j["holdout"];
     out["views"] = h->images;
@@ -250,7 +257,9 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
       r.knot_choice = FoldChoiceFromJson<KnotChoice>(k, name, "knot_choice");
       r.knot_choice->base_profile = k.at("base_profile").get<std::string>();
     }
-    if (j.contains("lens_choice")) r.lens_choice = FoldChoiceFromJson<LensChoice>(at("lens_choice"), name, "lens_choice");
+    if (j.contains("lens_choice")) r.lens_choice = FoldChoiceFromJson<NamedChoice>(at("lens_choice"), name, "lens_choice");
+    if (j.contains("tangential_choice"))
+      r.tangential_choice = FoldChoiceFromJson<NamedChoice>(at("tangential_choice"), name, "tangential_choice");
     if (j.contains("holdout")) {
       const json& h = at("holdout");
       HeldOutViews held;

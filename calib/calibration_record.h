@@ -47,7 +47,9 @@ struct CalibrationRecord {
   std::optional<HeldOutFolds> holdout_folds;  // every view held out once (CalibrationOptions::holdout_folds)
   std::optional<BoardWarpEstimate> board_warp;  // when fitted (CalibrationOptions::board_warp)
   std::optional<KnotChoice> knot_choice;  // when chosen (CalibrationOptions::knots = kChooseKnots)
-  std::optional<LensChoice> lens_choice;  // when chosen (CalibrationOptions::lens = kChooseLens)
+  std::optional<NamedChoice> lens_choice;  // when chosen (CalibrationOptions::lens = kChooseLens)
+  // When chosen (CalibrationOptions::tangential = kChooseTangential, a pinhole).
+  std::optional<NamedChoice> tangential_choice;
   // The two halves' calibrations compared (CalibrationOptions::cross_validate). The diff's
   // per-pixel vectors are kept in memory for the report's figure; the file has the summary.
   struct CrossValidationRecord {

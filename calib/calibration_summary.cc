@@ -24,6 +24,19 @@ void AppendFormatted(std::string& out, const char* format, ...) {
   va_end(args);
 }
 
+// "<what> chosen by 5 held-out folds (N corners): a: x px (chosen) b: y px".
+void AppendNamedChoice(const char* what, const NamedChoice& choice, std::string* out) {
+  *out += std::string(what) + " chosen by " + std::to_string(choice.folds) + " held-out folds (" +
+          std::to_string(choice.held_out_corners) + " corners):";
+  bool scored = false;
+  for (size_t k = 0; k < choice.candidates.size(); ++k) {
+    scored |= std::isfinite(choice.held_out_rms_px[k]);
+    AppendFormatted(*out, " %s: %.4f px%s", choice.candidates[k].c_str(), choice.held_out_rms_px[k],
+                    choice.candidates[k] == choice.chosen ? " (chosen)" : "");
+  }
+  *out += scored ? "\n" : " (none scored: the first kept)\n";
+}
+
 }  // namespace
 
 std::string CalibrationSummaryText(const CalibrationResult& result, const std::string& destination) {
@@ -57,17 +70,8 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
                       knots->held_out_rms_px[k], knots->candidates[k] == knots->chosen ? " (chosen)" : "");
     out += "\n";
   }
-  if (const auto& lens = record.lens_choice) {
-    out += "lens chosen by " + std::to_string(lens->folds) + " held-out folds (" + std::to_string(lens->held_out_corners) +
-           " corners):";
-    bool scored = false;
-    for (size_t k = 0; k < lens->candidates.size(); ++k) {
-      scored |= std::isfinite(lens->held_out_rms_px[k]);
-      AppendFormatted(out, " %s: %.4f px%s", lens->candidates[k].c_str(), lens->held_out_rms_px[k],
-                      lens->candidates[k] == lens->chosen ? " (chosen)" : "");
-    }
-    out += scored ? "\n" : " (neither scored: the first kept)\n";
-  }
+  if (const auto& lens = record.lens_choice) AppendNamedChoice("lens", *lens, &out);
+  if (const auto& tangential = record.tangential_choice) AppendNamedChoice("tangential terms p1, p2", *tangential, &out);
   if (const auto& held = record.holdout)
     AppendFormatted(out, "held out: %zu views, %d corners: RMS %.4f px (training %.4f px, ratio %.2f)\n",
                     held->images.size(), held->corners, held->rms_px, record.rms_all_px, held->rms_px / record.rms_all_px);

@@ -23,6 +23,7 @@ const char* WarningCodeName(WarningCode code) {
     case WarningCode::kHeldOutWorse: return "held_out_worse";
     case WarningCode::kKnotCountReplaced: return "knot_count_replaced";
     case WarningCode::kLensNotChosen: return "lens_not_chosen";
+    case WarningCode::kTangentialNotFitted: return "tangential_not_fitted";
     case WarningCode::kBoardScreenStopped: return "board_screen_stopped";
     case WarningCode::kImageRimNotUsed: return "image_rim_not_used";
   }

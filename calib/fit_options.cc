@@ -10,7 +10,7 @@ namespace omnical {
 namespace {
 
 // Each refine switch with the block name --fix holds it by and the parameter group it
-// moves: the one place the names live. "lens" holds the first three together.
+// moves: the one place the names live. "lens" holds the first four together.
 struct RefineSwitch {
   const char* name;
   bool RefineOptions::*member;
@@ -21,13 +21,14 @@ constexpr RefineSwitch kSwitches[] = {
     {"lens_scale", &RefineOptions::focal, ParameterGroup::kFocal, true},
     {"principal_point", &RefineOptions::principal_point, ParameterGroup::kPrincipalPoint, true},
     {"distortion", &RefineOptions::distortion, ParameterGroup::kDistortion, true},
+    {"tangential", &RefineOptions::tangential, ParameterGroup::kTangential, true},
     {"m", &RefineOptions::m, ParameterGroup::kMirrorDistance, true},
     {"tilt", &RefineOptions::tilt, ParameterGroup::kTilt, true},
     {"decenter", &RefineOptions::decenter, ParameterGroup::kDecenter, true},
     {"shape", &RefineOptions::shape, ParameterGroup::kShape, true},
     {"poses", &RefineOptions::poses, ParameterGroup::kShape, false},
 };
-constexpr int kLensSwitches = 3;
+constexpr int kLensSwitches = 4;
 
 const RefineSwitch& SwitchOf(ParameterGroup group) {
   for (const RefineSwitch& s : kSwitches)
@@ -60,7 +61,7 @@ std::string RefineOptions::Hold(const std::set<std::string>& names) {
 
 std::set<std::string> RefineOptions::HeldNames() const {
   std::set<std::string> names;
-  const bool whole_lens = !focal && !principal_point && !distortion;
+  const bool whole_lens = !focal && !principal_point && !distortion && !tangential;
   if (whole_lens) names.insert("lens");
   for (int k = whole_lens ? kLensSwitches : 0; k < static_cast<int>(std::size(kSwitches)); ++k)
     if (!(this->*kSwitches[k].member)) names.insert(kSwitches[k].name);
@@ -116,6 +117,9 @@ FitOptions FitOptions::DefaultsFor(const Sensor& sensor) {
         // "What the data can observe".)
         if constexpr (!Model::kOrthographic)
           if (HasFreeFormTerms(model.mirror)) options.refine.distortion = false;
+        // A decentred lens (p1, p2) trades with the mirror's decenter and the principal
+        // point: held unless asked for or chosen by held-out folds (calib/tangential_choice.h).
+        if constexpr (!Model::kOrthographic) options.refine.tangential = false;
       },
       sensor.model());
   return options;

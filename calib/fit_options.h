@@ -22,6 +22,7 @@ struct RefineOptions {
   bool focal = true;            // fx, fy of a pinhole; the scale of an orthographic lens
   bool principal_point = true;  // cx, cy
   bool distortion = true;       // k1, k2 of a pinhole
+  bool tangential = true;       // p1, p2 of a pinhole (DefaultsFor holds them)
   bool m = true;                // lens-to-vertex distance
   bool tilt = true;
   bool decenter = true;
@@ -30,10 +31,11 @@ struct RefineOptions {
 
   bool Refines(ParameterGroup group) const;
   // Holds the blocks named as the CLI's --fix and Python's fixed= name them: lens (focal,
-  // principal point and distortion), lens_scale (focal), principal_point, distortion, m,
-  // tilt, decenter, shape, poses. Empty, or "fixed: unknown block '...' (...)".
+  // principal point, distortion and tangential), lens_scale (focal), principal_point,
+  // distortion, tangential, m, tilt, decenter, shape, poses. Empty, or "fixed: unknown
+  // block '...' (...)".
   std::string Hold(const std::set<std::string>& names);
-  // The held blocks by those names (lens for focal + principal point + distortion).
+  // The held blocks by those names (lens for focal + principal point + both distortions).
   std::set<std::string> HeldNames() const;
   // Whether any sensor block is free (everything but the poses).
   bool RefinesSensor() const;
@@ -115,7 +117,8 @@ struct FitOptions {
 
   // The gauge-fixing defaults for a sensor, from the registry's traits: an orthographic
   // lens holds m, decenter and its scale; a profile whose tilt is not observable (a
-  // sphere: TiltObservable()) holds the tilt; free-form shape terms with a pinhole hold the distortion.
+  // sphere: TiltObservable()) holds the tilt; free-form shape terms with a pinhole hold the
+  // distortion; a pinhole's tangential terms are held (they trade with tilt and decenter).
   static FitOptions DefaultsFor(const Sensor& sensor);
   // Empty if valid, else "field: problem".
   std::string Check() const;

@@ -92,4 +92,33 @@ int PreferredCandidate(const std::vector<double>& held_out_rms_px, const std::ve
   return -1;
 }
 
+NamedChoice ChooseByHeldOutFolds(const std::vector<std::string>& names,
+                                 const std::vector<std::optional<FoldCandidate>>& candidates, double tolerance,
+                                 const CalibrationTarget& target, const DetectionSet& views, int threads,
+                                 const std::string& field, const ProgressCallback& progress,
+                                 const std::vector<std::optional<KnownScore>>& known) {
+  NamedChoice choice;
+  choice.candidates = names;
+  const auto known_at = [&](size_t k) { return k < known.size() ? known[k] : std::nullopt; };
+  std::vector<FoldCandidate> fitted;
+  for (size_t k = 0; k < candidates.size(); ++k)
+    if (candidates[k] && !known_at(k)) fitted.push_back(*candidates[k]);
+  const FoldScores scores = ScoreByHeldOutFolds(fitted, target, views, threads, field, field, progress);
+  choice.folds = scores.folds;
+  choice.held_out_corners = scores.held_out_corners;
+  size_t next = 0;
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    if (const std::optional<KnownScore> score = known_at(k)) {
+      choice.held_out_rms_px.push_back(score->held_out_rms_px);
+      if (std::isfinite(score->held_out_rms_px)) choice.held_out_corners = score->held_out_corners;
+    } else {
+      choice.held_out_rms_px.push_back(candidates[k] ? scores.held_out_rms_px[next++] : NAN);
+    }
+  }
+  const int preferred =
+      PreferredCandidate(choice.held_out_rms_px, std::vector<bool>(candidates.size(), false), tolerance);
+  choice.chosen = choice.candidates[preferred < 0 ? 0 : preferred];
+  return choice;
+}
+
 }  // namespace omnical

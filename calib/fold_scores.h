@@ -3,11 +3,13 @@
 // as the two halves are: a hand-held set drifts); each candidate is calibrated on the
 // rest and the held-out views' poses fitted with its sensor held (EvaluateHeldOutViews).
 // The score is the RMS over every held-out corner of every fold, per corner
-// sqrt(mean |e|^2). Used to choose a spline's knot count (calib/knot_choice.h) and the
-// lens of an unknown mirror (calib/lens_choice.h), never by training RMS, which only falls
-// as parameters are added.
+// sqrt(mean |e|^2). Used to choose a spline's knot count (calib/knot_choice.h), the lens
+// of an unknown mirror (calib/lens_choice.h) and whether a pinhole's tangential terms are
+// fitted (calib/tangential_choice.h), never by training RMS, which only falls as
+// parameters are added.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,5 +45,29 @@ FoldScores ScoreByHeldOutFolds(const std::vector<FoldCandidate>& candidates, con
 // The index of the first candidate not excluded whose score is within `tolerance` of the
 // lowest of them (list the simplest first); -1 when none has a score.
 int PreferredCandidate(const std::vector<double>& held_out_rms_px, const std::vector<bool>& excluded, double tolerance);
+
+// A choice among named candidates by their held-out scores (the lens; the tangential terms).
+struct NamedChoice {
+  std::vector<std::string> candidates;
+  std::vector<double> held_out_rms_px;  // per candidate, NaN when it failed (a fold, or a view's start pose)
+  int held_out_corners = 0;
+  int folds = 0;
+  std::string chosen;  // the first candidate where none scored
+};
+
+// A score measured before on the same views and folds, reused instead of refitting.
+struct KnownScore {
+  double held_out_rms_px = 0.0;
+  int held_out_corners = 0;
+};
+
+// The candidates given (one per name, the simplest first; an absent one scores NaN, one
+// with a `known` score takes it unfitted) scored by ScoreByHeldOutFolds, and the preferred
+// one within `tolerance` chosen.
+NamedChoice ChooseByHeldOutFolds(const std::vector<std::string>& names,
+                                 const std::vector<std::optional<FoldCandidate>>& candidates, double tolerance,
+                                 const CalibrationTarget& target, const DetectionSet& views, int threads,
+                                 const std::string& field, const ProgressCallback& progress,
+                                 const std::vector<std::optional<KnownScore>>& known = {});
 
 }  // namespace omnical

@@ -100,7 +100,7 @@ Catadioptric<double, Profile, PinholeLens> ThroughPinhole(const Catadioptric<dou
   const double rim_sag_mm = model.mirror.template EvaluateSag<double>(rim_mm * rim_mm).z;
   out.pose = {rim_mm / std::tan(theta_rad) - rim_sag_mm, 0.0, 0.0, 0.0, 0.0};
   const double focal_px = rim_px / std::tan(theta_rad);
-  out.lens = {focal_px, focal_px, model.lens.cx_px, model.lens.cy_px, 0.0, 0.0};
+  out.lens = {focal_px, focal_px, model.lens.cx_px, model.lens.cy_px, 0.0, 0.0, 0.0, 0.0};
   // The mirror reaches past the rim circle's nominal radius, as far as its family allows
   // (a sphere ends at its radius): the focal length and the mirror's size in mm trade
   // off, and the fits shrank the focal length while the shape grew outwards (on

@@ -6,7 +6,6 @@
 // wrong, and views it did not see show it.
 #pragma once
 
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,20 +22,9 @@ inline constexpr const char* kChooseLens = "auto";
 inline const std::vector<std::string> kLensCandidates = {"orthographic", "pinhole"};
 constexpr double kLensScoreTolerance = 0.01;
 
-struct LensChoice {
-  std::vector<std::string> candidates;
-  std::vector<double> held_out_rms_px;  // per candidate, NaN when it failed (a fold, or a view's start pose)
-  int held_out_corners = 0;
-  int folds = 0;
-  std::string chosen;
-};
-
-// One candidate per kLensCandidates, in that order, each started from the rim circle
-// through its lens; none where some view had no starting pose through it (scored NaN).
-// Where neither lens could be fitted to every fold, `chosen` is the first (calibrate
-// keeps its default start and warns lens_not_chosen). Throws InputError naming `lens`
-// with fewer than 4 views.
-LensChoice ChooseLens(const std::vector<std::optional<FoldCandidate>>& candidates, const CalibrationTarget& target,
-                      const DetectionSet& views, int threads, const ProgressCallback& progress);
+// Calibrate scores kLensCandidates with ChooseByHeldOutFolds, each started from the rim
+// circle through its lens (none, scored NaN, where some view had no starting pose through
+// it). Where neither lens could be fitted to every fold the first is kept, with the
+// warning lens_not_chosen.
 
 }  // namespace omnical

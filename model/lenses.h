@@ -16,34 +16,70 @@
 
 namespace omnical {
 
-// Pinhole with two radial distortion terms (OpenCV's k1, k2):
-// x' = x (1 + k1 r^2 + k2 r^4), r^2 = x^2 + y^2, x = X / Z; u = fx x' + cx.
-// Valid for Z > 0 and, for unprojection, where r (1 + k1 r^2 + k2 r^4) is increasing
-// (checked over the image by the sensor reader).
+// Pinhole with OpenCV's radial (k1, k2) and tangential (p1, p2) distortion:
+// x' = x (1 + k1 r^2 + k2 r^4) + 2 p1 x y + p2 (r^2 + 2 x^2),
+// y' = y (1 + k1 r^2 + k2 r^4) + p1 (r^2 + 2 y^2) + 2 p2 x y,
+// r^2 = x^2 + y^2, x = X / Z; u = fx x' + cx. Valid for Z > 0 and, for unprojection, where
+// the distortion is one-to-one (checked over the image by the sensor reader: the radial
+// part monotone; with p1, p2 also the whole map's Jacobian, model/sensor_validation.cc).
+// p1, p2 model a decentred lens element; the fit holds them unless asked or chosen by
+// held-out folds (calib/tangential_choice.h), since a lens tilt trades with the mirror's.
 template <typename T>
 struct PinholeLens {
   static constexpr const char* kName = "pinhole";
-  static constexpr int kNumParams = 6;
+  static constexpr int kNumParams = 8;
   static constexpr std::array<ParameterField, kNumParams> kFields{
       {ScalarField("fx", "fx_px", ParameterGroup::kFocal, true, FieldDomain::kPositive, 1e8),
        ScalarField("fy", "fy_px", ParameterGroup::kFocal, true, FieldDomain::kPositive, 1e8),
        ScalarField("cx", "cx_px", ParameterGroup::kPrincipalPoint, false, FieldDomain::kBounded, 1e7),
        ScalarField("cy", "cy_px", ParameterGroup::kPrincipalPoint, false, FieldDomain::kBounded, 1e7),
        ScalarField("k1", "k1", ParameterGroup::kDistortion, false, FieldDomain::kBounded, 1e6, 0, true),
-       ScalarField("k2", "k2", ParameterGroup::kDistortion, false, FieldDomain::kBounded, 1e6, 0, true)}};
+       ScalarField("k2", "k2", ParameterGroup::kDistortion, false, FieldDomain::kBounded, 1e6, 0, true),
+       // Written only when not 0: files without them read the same in older versions.
+       OmittedWhenZero(ScalarField("p1", "p1", ParameterGroup::kTangential, false, FieldDomain::kBounded, 1.0, 0, true)),
+       OmittedWhenZero(ScalarField("p2", "p2", ParameterGroup::kTangential, false, FieldDomain::kBounded, 1.0, 0, true))}};
   static constexpr bool kIsOrthographic = false;
-  T fx_px, fy_px, cx_px, cy_px, k1, k2;
+  T fx_px, fy_px, cx_px, cy_px, k1, k2, p1, p2;
+
+  // The distorted normalised point (x', y') of an undistorted one (x, y).
+  void Distort(const T& x, const T& y, T* distorted_x, T* distorted_y) const {
+    const T r2 = x * x + y * y;
+    const T radial = T(1.0) + r2 * (k1 + r2 * k2);
+    *distorted_x = x * radial + T(2.0) * p1 * x * y + p2 * (r2 + T(2.0) * x * x);
+    *distorted_y = y * radial + p1 * (r2 + T(2.0) * y * y) + T(2.0) * p2 * x * y;
+  }
 
   // Valid in front of the lens (Z > 0). The pixel is written either way (without a
   // branch, so the batch loops vectorise); callers ignore it when false is returned.
   bool ProjectToPixel(const Vec3<T>& point_in_camera, Vec2<T>* pixel) const {
     const T x = point_in_camera.x() / point_in_camera.z();
     const T y = point_in_camera.y() / point_in_camera.z();
-    const T r2 = x * x + y * y;
-    const T radial = T(1.0) + r2 * (k1 + r2 * k2);
-    (*pixel)(0) = fx_px * x * radial + cx_px;
-    (*pixel)(1) = fy_px * y * radial + cy_px;
+    T distorted_x, distorted_y;
+    Distort(x, y, &distorted_x, &distorted_y);
+    (*pixel)(0) = fx_px * distorted_x + cx_px;
+    (*pixel)(1) = fy_px * distorted_y + cy_px;
     return ScalarPart(point_in_camera.z()) > 0.0;
+  }
+
+  bool HasTangential() const { return ScalarPart(p1) != 0.0 || ScalarPart(p2) != 0.0; }
+
+  // d(x', y') / d(x, y) at an undistorted point, in double; its inverse applied to a vector.
+  Eigen::Matrix2d DistortionJacobian(double x, double y) const {
+    const double a = ScalarPart(k1), b = ScalarPart(k2), t1 = ScalarPart(p1), t2 = ScalarPart(p2);
+    const double r2 = x * x + y * y;
+    const double radial = 1.0 + r2 * (a + r2 * b);
+    const double radial_slope = 2.0 * (a + 2.0 * b * r2);  // d radial / d(x or y), over x or y
+    Eigen::Matrix2d jacobian;
+    jacobian << radial + radial_slope * x * x + 2.0 * t1 * y + 6.0 * t2 * x,
+        radial_slope * x * y + 2.0 * t1 * x + 2.0 * t2 * y,
+        radial_slope * x * y + 2.0 * t1 * x + 2.0 * t2 * y,
+        radial + radial_slope * y * y + 6.0 * t1 * y + 2.0 * t2 * x;
+    return jacobian;
+  }
+  static Eigen::Vector2d SolveJacobian(const Eigen::Matrix2d& jacobian, const Eigen::Vector2d& vector) {
+    const double det = jacobian(0, 0) * jacobian(1, 1) - jacobian(0, 1) * jacobian(1, 0);
+    return Eigen::Vector2d(jacobian(1, 1) * vector.x() - jacobian(0, 1) * vector.y(),
+                           jacobian(0, 0) * vector.y() - jacobian(1, 0) * vector.x()) / det;
   }
 
   // Undistorted radius r for a distorted radius rd: safeguarded Newton on
@@ -78,18 +114,63 @@ struct PinholeLens {
     }
   }
 
+  // Undistorted point of a distorted one with p1, p2: Newton on the 2-D map in double from
+  // the radial solution, each step halved until the residual falls (the sensor reader
+  // guarantees the map one-to-one with a well-conditioned Jacobian over the image), then
+  // one Newton step in T (the implicit-function derivative for Jets, as for the radius).
+  Vec2<T> UndistortPoint(const T& distorted_x, const T& distorted_y) const {
+    const PinholeLens<double> lens = Cast<double>();
+    const Eigen::Vector2d target(ScalarPart(distorted_x), ScalarPart(distorted_y));
+    const double radius = target.norm();
+    Eigen::Vector2d point = target;
+    if (radius > 0.0) point *= lens.UndistortRadius(radius) / radius;
+    auto residual_at = [&](const Eigen::Vector2d& p) {
+      Eigen::Vector2d distorted;
+      lens.Distort(p.x(), p.y(), &distorted.x(), &distorted.y());
+      return Eigen::Vector2d(distorted - target);
+    };
+    Eigen::Vector2d residual = residual_at(point);
+    for (int iteration = 0; iteration < 50 && residual.norm() > 1e-15 * (1.0 + radius); ++iteration) {
+      const Eigen::Vector2d step = SolveJacobian(lens.DistortionJacobian(point.x(), point.y()), residual);
+      double fraction = 1.0;
+      Eigen::Vector2d next = point - step, next_residual = residual_at(next);
+      for (int halving = 0; halving < 30 && !(next_residual.norm() < residual.norm()); ++halving) {
+        fraction *= 0.5;
+        next = point - fraction * step;
+        next_residual = residual_at(next);
+      }
+      if (!(next_residual.norm() < residual.norm())) break;  // at rounding level
+      point = next, residual = next_residual;
+    }
+    if constexpr (std::is_same_v<T, double>) {
+      return point;
+    } else {
+      const T x(point.x()), y(point.y());
+      T distorted_at_x, distorted_at_y;
+      Distort(x, y, &distorted_at_x, &distorted_at_y);
+      const T error_x = distorted_at_x - distorted_x, error_y = distorted_at_y - distorted_y;
+      // J^-1 error, with J in double: the Jets' derivative parts are carried by `error`.
+      const Eigen::Matrix2d jacobian = lens.DistortionJacobian(point.x(), point.y());
+      const double det = jacobian(0, 0) * jacobian(1, 1) - jacobian(0, 1) * jacobian(1, 0);
+      return Vec2<T>(x - (jacobian(1, 1) * error_x - jacobian(0, 1) * error_y) / det,
+                     y - (jacobian(0, 0) * error_y - jacobian(1, 0) * error_x) / det);
+    }
+  }
+
   // Ray through the lens centre for a pixel: origin 0, unit direction.
   void PixelToRay(const Vec2<T>& pixel, Vec3<T>* origin, Vec3<T>* direction) const {
     using std::sqrt;
     const T xd = (pixel(0) - cx_px) / fx_px;
     const T yd = (pixel(1) - cy_px) / fy_px;
-    const T rd2 = xd * xd + yd * yd;
-    T scale(1.0);
-    if (ScalarPart(rd2) > 0.0) {
+    Vec3<T> ray(xd, yd, T(1.0));
+    // Jets take the 2-D solve even where p1 = p2 = 0: the radial one has no derivative in them.
+    if (HasTangential() || !std::is_same_v<T, double>) {
+      ray.template head<2>() = UndistortPoint(xd, yd);
+    } else if (const T rd2 = xd * xd + yd * yd; ScalarPart(rd2) > 0.0) {
       const T rd = sqrt(rd2);
-      scale = UndistortRadius(rd) / rd;
+      const T scale = UndistortRadius(rd) / rd;
+      ray(0) *= scale, ray(1) *= scale;
     }
-    const Vec3<T> ray(xd * scale, yd * scale, T(1.0));
     *origin = Vec3<T>::Zero();
     *direction = ray / ray.norm();
   }
@@ -104,12 +185,12 @@ struct PinholeLens {
   }
   template <typename U>
   PinholeLens<U> Cast() const {
-    return {CastScalar<U>(fx_px), CastScalar<U>(fy_px), CastScalar<U>(cx_px),
-            CastScalar<U>(cy_px), CastScalar<U>(k1),    CastScalar<U>(k2)};
+    return {CastScalar<U>(fx_px), CastScalar<U>(fy_px), CastScalar<U>(cx_px), CastScalar<U>(cy_px),
+            CastScalar<U>(k1),    CastScalar<U>(k2),    CastScalar<U>(p1),    CastScalar<U>(p2)};
   }
-  static PinholeLens FromParams(const T* p) { return {p[0], p[1], p[2], p[3], p[4], p[5]}; }
+  static PinholeLens FromParams(const T* p) { return {p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]}; }
   void ToParams(T* p) const {
-    p[0] = fx_px; p[1] = fy_px; p[2] = cx_px; p[3] = cy_px; p[4] = k1; p[5] = k2;
+    p[0] = fx_px; p[1] = fy_px; p[2] = cx_px; p[3] = cy_px; p[4] = k1; p[5] = k2; p[6] = p1; p[7] = p2;
   }
 };
 

@@ -36,7 +36,9 @@ FieldSample AnalyzeSample(const Model& model, double x, double near_distance_mm)
     sample.h_px = model.lens.scale_px_per_mm * x;
     dh_dx = model.lens.scale_px_per_mm;
   } else {
-    // Eq. 7, h = b tan(theta), with the lens's radial distortion along the x axis.
+    // Eq. 7, h = b tan(theta), with the lens's radial distortion along the x axis. Its
+    // tangential terms (a decentred lens) are left out: the seed's characteristics are
+    // those of the rotationally symmetric design.
     const double depth = m + ray.z_mm;
     const double t = x / depth;
     const double dt_dx = (depth - x * fp) / (depth * depth);

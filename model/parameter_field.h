@@ -9,7 +9,7 @@
 namespace omnical {
 
 // Which refine switch of the bundle fit a parameter answers to (calib/bundle_fit.h).
-enum class ParameterGroup { kFocal, kPrincipalPoint, kDistortion, kMirrorDistance, kTilt, kDecenter, kShape };
+enum class ParameterGroup { kFocal, kPrincipalPoint, kDistortion, kTangential, kMirrorDistance, kTilt, kDecenter, kShape };
 
 // How the sensor file checks a value: > 0 and <= bound, or |value| <= bound.
 enum class FieldDomain { kPositive, kBounded };
@@ -27,6 +27,7 @@ struct ParameterField {
   FieldDomain domain = FieldDomain::kBounded;
   double bound = 0.0;
   bool optional = false;  // a scalar absent from the sensor file is 0
+  bool omitted_when_zero = false;  // an optional scalar the sensor file leaves out when 0
   int min_count = 1, max_count = 1;
   int first_number = 0, number_step = 0;  // a list's names: name + (first + k step)
   // A value in mm^p, p = length_power + k length_power_step: the design fit's normalised
@@ -48,6 +49,12 @@ constexpr ParameterField ScalarField(const char* key, const char* name, Paramete
   field.domain = domain, field.bound = bound;
   field.length_power = length_power;
   field.optional = optional;
+  return field;
+}
+
+// An optional scalar the sensor file leaves out when it is 0.
+constexpr ParameterField OmittedWhenZero(ParameterField field) {
+  field.omitted_when_zero = true;
   return field;
 }
 

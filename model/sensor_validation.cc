@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -43,6 +44,49 @@ std::string CheckDistortion(const PinholeLens<double>& lens, double max_undistor
     return Describe("camera.k1: radial distortion (k1, k2) folds or flattens (slope < 0.1) at normalised radius %.4g, "
                     "inside the image or the mirror's image",
                     r_fold);
+  return {};
+}
+
+// With p1, p2 the distortion is a 2-D map. Its Jacobian is symmetric (the map is a
+// gradient), and where it stays positive definite on a disc the map is one-to-one there;
+// where its smallest eigenvalue stays >= kMinSlope the inverse amplifies errors at most
+// 1 / kMinSlope. Checked on a polar grid over the undistorted disc that reaches the
+// mirror's outermost point and whose boundary images outside the image corners' radius
+// (so every pixel's preimage lies in it): the disc is grown from the radial preimage of
+// the corners until its boundary clears them (the tangential terms pull part of it in).
+std::string CheckTangential(const PinholeLens<double>& lens, double max_undistorted, double max_distorted) {
+  if (!lens.HasTangential()) return {};
+  constexpr double kMinSlope = 0.1;
+  constexpr int kRadii = 48, kAzimuths = 96;
+  const auto boundary_distorted = [&](double radius) {
+    double nearest = HUGE_VAL;
+    for (int k = 0; k < kAzimuths; ++k) {
+      const double phi = 2.0 * M_PI * k / kAzimuths;
+      double distorted_x = 0.0, distorted_y = 0.0;
+      lens.Distort(radius * std::cos(phi), radius * std::sin(phi), &distorted_x, &distorted_y);
+      nearest = std::min(nearest, std::hypot(distorted_x, distorted_y));
+    }
+    return nearest;
+  };
+  double radius = std::max(max_undistorted, lens.UndistortRadius(max_distorted));
+  for (int grow = 0; grow < 100 && !(boundary_distorted(radius) >= max_distorted); ++grow) radius *= 1.02;
+  for (int i = 1; i <= kRadii; ++i) {
+    const double r = radius * i / kRadii;
+    for (int k = 0; k < kAzimuths; ++k) {
+      const double phi = 2.0 * M_PI * k / kAzimuths;
+      const Eigen::Matrix2d jacobian = lens.DistortionJacobian(r * std::cos(phi), r * std::sin(phi));
+      const double mean = 0.5 * (jacobian(0, 0) + jacobian(1, 1));
+      const double half_gap = std::hypot(0.5 * (jacobian(0, 0) - jacobian(1, 1)), jacobian(0, 1));
+      if (!(mean - half_gap >= kMinSlope))
+        return Describe("camera.p1: the distortion (k1, k2, p1, p2) folds or flattens (slope < 0.1) at normalised "
+                        "radius %.4g, azimuth %.0f deg, inside the image or the mirror's image",
+                        r, phi * 180.0 / M_PI);
+    }
+  }
+  if (!(boundary_distorted(radius) >= max_distorted))
+    return Describe("camera.p1: the tangential distortion (p1, p2) leaves image corners without a preimage within "
+                    "normalised radius %.4g (too large p1, p2?)",
+                    radius);
   return {};
 }
 
@@ -112,6 +156,7 @@ std::string ValidateSensorModel(const SensorModel& model) {
           const double corner_v = std::max(std::abs(m.lens.cy_px + 0.5), std::abs(m.image_height_px - 0.5 - m.lens.cy_px));
           const double max_distorted = std::hypot(corner_u / m.lens.fx_px, corner_v / m.lens.fy_px);
           if (std::string why = CheckDistortion(m.lens, max_tan, max_distorted); !why.empty()) return why;
+          if (std::string why = CheckTangential(m.lens, max_tan, max_distorted); !why.empty()) return why;
         }
         return {};
       },

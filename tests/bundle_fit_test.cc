@@ -152,9 +152,11 @@ TEST(BundleFit, RecoversTheMisalignedSphereFromExactObservations) {
   for (size_t v = 0; v < poses.size(); ++v)
     ASSERT_TRUE(InitialTargetPose(guess, truth.target, truth.detections.images[v], &poses[v])) << v;
   const FitResult fit = FitSensor(guess, truth.target, truth.detections, poses, FitOptions::DefaultsFor(guess));
-  // The sphere's tilt is its gauge (held at the guess, 2 deg off); everything else, and
-  // the sphere's centre that tilt, decenter and m describe together, comes back exactly.
-  for (const ParameterEstimate& p : fit.parameters) EXPECT_EQ(p.fixed, p.name.rfind("tilt", 0) == 0) << p.name;
+  // The sphere's tilt is its gauge (held at the guess, 2 deg off) and p1, p2 are held by
+  // default (the truth has none); everything else, and the sphere's centre that tilt,
+  // decenter and m describe together, comes back exactly.
+  for (const ParameterEstimate& p : fit.parameters)
+    EXPECT_EQ(p.fixed, p.name.rfind("tilt", 0) == 0 || p.name == "p1" || p.name == "p2") << p.name;
   auto centre = [](const Sensor& sensor) {
     const auto& m = std::get<Catadioptric<double, SphereProfile, PinholeLens>>(sensor.model());
     return Eigen::Vector3d(m.pose.CameraFromMirrorRotation() * Eigen::Vector3d(0, 0, m.mirror.radius_of_curvature_mm) +
@@ -519,13 +521,18 @@ TEST(RefineOptions, HoldsBlocksByTheirNamesAndRejectsUnknownOnes) {
   EXPECT_NE(refine.Hold({"lens", "focal"}).find("unknown block 'focal'"), std::string::npos);
   refine = RefineOptions();
   EXPECT_EQ(refine.Hold({"lens", "m"}), "");
-  EXPECT_FALSE(refine.focal || refine.principal_point || refine.distortion || refine.m);
+  EXPECT_FALSE(refine.focal || refine.principal_point || refine.distortion || refine.tangential || refine.m);
   EXPECT_TRUE(refine.tilt && refine.decenter && refine.shape && refine.poses);
   EXPECT_EQ(refine.HeldNames(), (std::set<std::string>{"lens", "m"}));
   refine = RefineOptions();
   EXPECT_EQ(refine.Hold({"principal_point", "distortion"}), "");
   EXPECT_EQ(refine.HeldNames(), (std::set<std::string>{"distortion", "principal_point"}));
   EXPECT_TRUE(refine.RefinesSensor());
+  // Held by a pinhole's defaults, the tangential terms are named; the whole lens only with them.
+  refine.tangential = false;
+  EXPECT_EQ(refine.HeldNames(), (std::set<std::string>{"distortion", "principal_point", "tangential"}));
+  EXPECT_EQ(refine.Hold({"lens"}), "");
+  EXPECT_EQ(refine.HeldNames(), (std::set<std::string>{"lens"}));
   const RefineOptions poses = RefineOptions::PosesOnly();
   EXPECT_FALSE(poses.RefinesSensor());
   EXPECT_TRUE(poses.poses);

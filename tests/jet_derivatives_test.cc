@@ -99,6 +99,44 @@ TEST_P(JetDerivatives, AgreeWithCentralDifferences) {
       sensor.model());
 }
 
+// The pinhole's unprojection (the radial solve, or the 2-D one with p1, p2, each with its
+// implicit-function step in T): the ray's direction against central differences in every
+// lens parameter and the pixel, with and without tangential terms. p1 = p2 = 0 must still
+// give their derivatives (a fit frees them from 0).
+TEST(PinholeUnprojection, JetsAgreeWithCentralDifferences) {
+  using LensJet = ceres::Jet<double, 10>;
+  for (const bool decentred : {false, true}) {
+    const std::vector<double> values = {1900.0, 1902.0, 503.0, 497.0, -0.04, 0.02,
+                                        decentred ? 0.008 : 0.0, decentred ? -0.006 : 0.0, 820.0, 260.0};
+    auto direction_of = [](const auto& v) {
+      using T = std::decay_t<decltype(v[0])>;
+      const PinholeLens<T> lens = PinholeLens<T>::FromParams(v.data());
+      Vec3<T> origin, direction;
+      lens.PixelToRay(Vec2<T>(v[8], v[9]), &origin, &direction);
+      return direction;
+    };
+    std::vector<LensJet> jets(values.size());
+    for (size_t k = 0; k < values.size(); ++k) jets[k] = LensJet(values[k], static_cast<int>(k));
+    const Vec3<LensJet> direction = direction_of(jets);
+    for (size_t k = 0; k < values.size(); ++k) {
+      const double step = 1e-6 * std::max(std::abs(values[k]), 1.0);
+      std::vector<double> plus = values, minus = values;
+      plus[k] += step, minus[k] -= step;
+      const Eigen::Vector3d numeric = (direction_of(plus) - direction_of(minus)) / (2.0 * step);
+      for (int axis = 0; axis < 3; ++axis)
+        EXPECT_NEAR(direction(axis).v[k], numeric(axis), 1e-6 * std::max(1.0, std::abs(numeric(axis))))
+            << (decentred ? "decentred" : "centred") << " parameter " << k << " axis " << axis;
+    }
+    // The ray projects back to its pixel.
+    Vec2<double> pixel;
+    const PinholeLens<double> lens = PinholeLens<double>::FromParams(values.data());
+    Vec3<double> origin, ray;
+    lens.PixelToRay(Vec2<double>(values[8], values[9]), &origin, &ray);
+    ASSERT_TRUE(lens.ProjectToPixel(ray, &pixel));
+    EXPECT_LT((pixel - Vec2<double>(values[8], values[9])).norm(), 1e-9);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Models, JetDerivatives, ::testing::Range(0, static_cast<int>(testing::AllTestSensors().size())),
                          [](const ::testing::TestParamInfo<int>& info) {
                            std::string name = testing::AllTestSensors()[info.param].name;

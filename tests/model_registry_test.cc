@@ -45,15 +45,16 @@ TEST(ModelRegistry, ParameterListsComeFromTheFields) {
   Catadioptric<double, EvenAsphereProfile, PinholeLens> asphere;
   asphere.mirror = EvenAsphereProfile<double>::FromParams(params.data(), 5);
   const std::vector<ParameterInfo> infos = SensorParameterInfos(asphere);
-  EXPECT_EQ(Names(infos), (std::vector<std::string>{"fx_px", "fy_px", "cx_px", "cy_px", "k1", "k2", "m_mm", "tilt_x_deg",
-                                                    "tilt_y_deg", "decenter_x_mm", "decenter_y_mm", "R_mm", "k", "a4",
-                                                    "a6", "a8"}));
+  EXPECT_EQ(Names(infos), (std::vector<std::string>{"fx_px", "fy_px", "cx_px", "cy_px", "k1", "k2", "p1", "p2", "m_mm",
+                                                    "tilt_x_deg", "tilt_y_deg", "decenter_x_mm", "decenter_y_mm", "R_mm",
+                                                    "k", "a4", "a6", "a8"}));
   EXPECT_EQ(infos[0].group, ParameterGroup::kFocal);
   EXPECT_EQ(infos[2].group, ParameterGroup::kPrincipalPoint);
   EXPECT_EQ(infos[4].group, ParameterGroup::kDistortion);
-  EXPECT_EQ(infos[6].group, ParameterGroup::kMirrorDistance);
-  EXPECT_TRUE(infos[0].scale_like && infos[6].scale_like && infos[11].scale_like);  // fx, m, R
-  EXPECT_FALSE(infos[12].scale_like || infos[13].scale_like);                      // k, a4
+  EXPECT_EQ(infos[6].group, ParameterGroup::kTangential);
+  EXPECT_EQ(infos[8].group, ParameterGroup::kMirrorDistance);
+  EXPECT_TRUE(infos[0].scale_like && infos[8].scale_like && infos[13].scale_like);  // fx, m, R
+  EXPECT_FALSE(infos[6].scale_like || infos[14].scale_like || infos[15].scale_like);  // p1, k, a4
   EXPECT_TRUE(HasFreeFormTerms(asphere.mirror));
   EXPECT_FALSE(HasFreeFormTerms(EvenAsphereProfile<double>::FromParams(params.data(), 2)));
 
@@ -63,7 +64,7 @@ TEST(ModelRegistry, ParameterListsComeFromTheFields) {
             (std::vector<std::string>{"scale_px_per_mm", "cx_px", "cy_px", "m_mm", "tilt_x_deg", "tilt_y_deg",
                                       "decenter_x_mm", "decenter_y_mm", "c1", "c2", "c3"}));
   Catadioptric<double, TabulatedProfile, PinholeLens> tabulated;
-  EXPECT_EQ(SensorParameterInfos(tabulated).size(), 11u);  // no shape parameter
+  EXPECT_EQ(SensorParameterInfos(tabulated).size(), 13u);  // no shape parameter
 }
 
 // The asphere twin of a conic: the sphere (k = 0, R = A), the paraboloid (k = -1, R = 2 A),

@@ -127,7 +127,7 @@ TEST(RealImages, MeiParabolicDetectsAndCalibrates) {
   options.threads = 2;
   const CalibrationRecord chosen = Calibrate(input, options).record;
   ASSERT_TRUE(chosen.lens_choice.has_value());
-  const LensChoice& lens = *chosen.lens_choice;
+  const NamedChoice& lens = *chosen.lens_choice;
   std::printf("lens choice: orthographic %.4f px, pinhole %.4f px held out\n", lens.held_out_rms_px[0], lens.held_out_rms_px[1]);
   EXPECT_EQ(lens.chosen, "orthographic");
   EXPECT_EQ(std::string(chosen.start), "rim circle, polynomial mirror, orthographic lens (chosen by held-out folds)");

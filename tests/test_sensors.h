@@ -1,6 +1,6 @@
 // Sensors for the model tests: every profile with every lens, aligned or misaligned
-// (tilt 2 deg + decenter 1 mm, the test case, plus radial distortion on the
-// pinhole), scaled so the rim images at about 480 px from the centre of a 1000 x 1000 image.
+// (tilt 2 deg + decenter 1 mm, the test case, plus radial and tangential
+// distortion on the pinhole), scaled so the rim images at about 480 px from the centre of a 1000 x 1000 image.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -41,8 +41,10 @@ Catadioptric<double, Profile, Lens> MakeModel(const Profile<double>& profile, do
     model.lens = {480.0 / kRimMm, 499.5, 499.5};
   } else {
     const double f_px = 480.0 * (m_mm + rim_sag) / kRimMm;
-    // The misaligned variants carry radial distortion too, so every harness covers it.
-    model.lens = {f_px, f_px * 1.001, 499.5, 499.5, misaligned ? -0.04 : 0.0, misaligned ? 0.02 : 0.0};
+    // The misaligned variants carry radial and tangential distortion too, so every harness
+    // covers them.
+    model.lens = {f_px, f_px * 1.001, 499.5, 499.5, misaligned ? -0.04 : 0.0, misaligned ? 0.02 : 0.0,
+                  misaligned ? 0.002 : 0.0, misaligned ? -0.0015 : 0.0};
   }
   return model;
 }

@@ -34,7 +34,7 @@ const FlagTable kFlags = {{"fixed", "--fix"}, {"robust_loss_px", "--loss-px"}, {
                           {"distances_n", "--distance-n"}, {"max_predicted_error_px", "--max-predicted-error-px"},
                           {"holdout_views", "--holdout"}, {"holdout", "--holdout"}, {"holdout_folds", "--holdout-folds"}, {"cross_validate", "--cross-validate"},
                           {"cross_validation_distance_mm", "--cross-validate-distance-mm"}, {"knots", "--knots"},
-                          {"lens", "--lens"}, {"checkerboard_edges", "--checkerboard-edges"}};
+                          {"lens", "--lens"}, {"tangential", "--tangential"}, {"checkerboard_edges", "--checkerboard-edges"}};
 
 void RunCalibrate(CalibrateFlags options, const Context& context) {
   CalibrationInput input;
@@ -102,7 +102,7 @@ Command CalibrateCommand() {
             library.threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
             sub.add_option("--threads", library.threads, "Threads: detection, board checks and the fit's Jacobians (the result is the same for any count)")->check(CLI::Range(1, 256))->capture_default_str();
             sub.add_option("--out", options->out_dir, "Output directory")->required();
-            sub.add_option("--fix", options->fix, "Blocks held constant: lens, lens_scale, principal_point, distortion, m, tilt, decenter, shape, poses");
+            sub.add_option("--fix", options->fix, "Blocks held constant: lens, lens_scale, principal_point, distortion, tangential, m, tilt, decenter, shape, poses");
             sub.add_option("--loss-px", library.loss_px, "Huber loss scale, px (0: least squares)")
                 ->check(CLI::Range(0.0, 1000.0))->capture_default_str();
             sub.add_option("--max-iterations", library.max_iterations, "Solver iterations per stage")

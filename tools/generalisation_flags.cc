@@ -25,6 +25,11 @@ void AddGeneralisationFlags(CLI::App& sub, CalibrationOptions* library) {
                  "pinhole (a perspective camera; with a free-form mirror m and decenter held as gauges) or auto: the "
                  "one predicting held-out folds better (calibration.json lens_choice)")
       ->check(CLI::IsMember({"orthographic", "pinhole", "auto"}));
+  sub.add_option("--tangential", library->tangential,
+                 "A pinhole's tangential distortion p1, p2 (a decentred lens): off (default, held at the start's "
+                 "values), on (fitted) or auto: fitted only where that predicts held-out folds better by > 1 % "
+                 "(calibration.json tangential_choice)")
+      ->check(CLI::IsMember({"off", "on", "auto"}));
   sub.add_flag("--leave-one-out", library->leave_one_out,
                "Also fit without each image in turn; calibration.json gets each parameter's spread");
 }

@@ -18,7 +18,7 @@ Sensor SensorFromOdeDesign(const OdeDesignSpec& spec, const OdeDesign& design, i
   model.mirror.source = table_path;
   const double focal_px = spec.focal_length_mm / PixelPitchMm(design, image_size_px);
   const double centre_px = 0.5 * (image_size_px - 1);
-  model.lens = {focal_px, focal_px, centre_px, centre_px, 0.0, 0.0};
+  model.lens = {focal_px, focal_px, centre_px, centre_px, 0.0, 0.0, 0.0, 0.0};
   model.pose = {design.profile.front().height_mm - spec.focal_length_mm, 0.0, 0.0, 0.0, 0.0};
   model.rim_radius_mm = design.t_end_mm;
   model.image_width_px = model.image_height_px = image_size_px;

@@ -280,7 +280,7 @@ Sensor SensorFromFitDesign(const FitDesign& design, const FitDesignSpec& spec, d
   std::optional<Sensor> sensor;
   WithDesignProfile(design.profile, [&](auto tag) {
     typename decltype(tag)::type model;
-    model.lens = PinholeLens<double>{focal_px, focal_px, centre_px, centre_px, 0.0, 0.0};
+    model.lens = PinholeLens<double>{focal_px, focal_px, centre_px, centre_px, 0.0, 0.0, 0.0, 0.0};
     model.pose = MirrorPose<double>{design.m * scale, 0.0, 0.0, 0.0, 0.0};
     // A parameter of length power p (z = sum c_k x^2k: c_k in mm^(1-2k)) scales by M^p.
     std::vector<double> mm(design.params.size());

@@ -174,14 +174,15 @@ SensorModel ReadModel(const FieldReader& reader, const YAML::Node& root) {
   return *model;
 }
 
-// A lens or profile's fields written from its flat parameter array: a scalar as its key,
-// a list as a flow sequence.
+// A lens or profile's fields written from its flat parameter array: a scalar as its key
+// (left out where 0 and omitted_when_zero), a list as a flow sequence.
 void WriteFields(YAML::Emitter& out, const ParameterField* fields, size_t num_fields, const std::vector<int>& counts,
                  const double* params) {
   int index = 0;
   for (size_t f = 0; f < num_fields; ++f) {
     if (!fields[f].is_list()) {
-      out << YAML::Key << fields[f].key << YAML::Value << params[index++];
+      const double value = params[index++];
+      if (!(fields[f].omitted_when_zero && value == 0.0)) out << YAML::Key << fields[f].key << YAML::Value << value;
       continue;
     }
     if (counts[f] == 0) continue;

@@ -103,7 +103,7 @@ void CheckMatchesScalar(benchmark::State& state, const Sensor& sensor, const Eig
 
 void BM_Baseline_PinholeDistortedProjection(benchmark::State& state) {
   const Workload& workload = AxialWorkload();
-  const PinholeLens<double> lens{2352.4, 2352.4, 499.5, 499.5, -0.05, 0.01};
+  const PinholeLens<double> lens{2352.4, 2352.4, 499.5, 499.5, -0.05, 0.01, 0.0, 0.0};
   Eigen::Matrix2Xd pixels(2, workload.points.cols());
   for (auto _ : state) {
     for (Eigen::Index i = 0; i < workload.points.cols(); ++i) {

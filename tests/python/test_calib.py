@@ -258,6 +258,13 @@ def test_load_calibration_round_trip(runs, tmp_path):
     assert lens["candidates"] == ["orthographic", "pinhole"] and lens["chosen"] == "orthographic"
     assert lens["held_out_rms_px"][0] == 2.5 and math.isnan(lens["held_out_rms_px"][1]) and lens["folds"] == 5
     assert record.lens_choice is None
+    # The tangential choice (--tangential auto) reads back the same way.
+    data["tangential_choice"] = {"candidates": ["held", "fitted"], "held_out_rms_px": [0.31, 0.30],
+                                 "held_out_corners": 1644, "folds": 5, "chosen": "fitted"}
+    (tmp_path / "tangential.json").write_text(json.dumps(data))
+    tangential = omnical.load_calibration(tmp_path / "tangential.json").tangential_choice
+    assert tangential["chosen"] == "fitted" and tangential["held_out_rms_px"] == [0.31, 0.30]
+    assert record.tangential_choice is None
 
 
 def test_calibrate_from_detections_without_guess_with_leave_one_out(runs, tmp_path):
@@ -604,6 +611,15 @@ def test_bad_option_values_name_the_argument(runs, tmp_path):
     with pytest.raises(omnical.InputError) as caught:
         omnical.calibrate(TARGET, detections=detections, guess=GUESS, lens="pinhole")
     assert str(caught.value) == with_guess and ": lens: the guess has its lens (pinhole)" in with_guess
+    # The tangential terms: one of three, and only for a pinhole (the rim circle's default
+    # lens is orthographic), with the CLI's text (which names its flag).
+    with pytest.raises(omnical.InputError, match=r"^tangential: off, on or auto \(got 'yes'\)"):
+        omnical.calibrate(TARGET, detections=detections, tangential="yes")
+    orthographic = cli_error(run_cli("calibrate", "--target", TARGET, "--detections", detections, "--tangential",
+                                     "auto", "--out", tmp_path / "tangential"))
+    with pytest.raises(omnical.InputError) as caught:
+        omnical.calibrate(TARGET, detections=detections, tangential="auto")
+    assert orthographic == "--" + str(caught.value) and orthographic.startswith("--tangential: the orthographic lens has no")
 
 
 # --- target ------------------------------------------------------------------------------

@@ -257,16 +257,20 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
       },
       "The spline's knot count chosen by held-out folds (knots='auto'): dict base_profile, candidates (0: base_profile, no spline), held_out_rms_px (per "
       "candidate), held_out_corners, folds, chosen; None unless chosen.");
+  const auto named_choice = [](const std::optional<NamedChoice>& choice) -> py::object {
+    if (!choice) return py::none();
+    return py::dict("candidates"_a = choice->candidates, "held_out_rms_px"_a = choice->held_out_rms_px,
+                    "held_out_corners"_a = choice->held_out_corners, "folds"_a = choice->folds, "chosen"_a = choice->chosen);
+  };
   cls.def_property_readonly(
-      "lens_choice",
-      [record](const Holder& holder) -> py::object {
-        const auto& l = record(holder).lens_choice;
-        if (!l) return py::none();
-        return py::dict("candidates"_a = l->candidates, "held_out_rms_px"_a = l->held_out_rms_px,
-                        "held_out_corners"_a = l->held_out_corners, "folds"_a = l->folds, "chosen"_a = l->chosen);
-      },
+      "lens_choice", [record, named_choice](const Holder& holder) { return named_choice(record(holder).lens_choice); },
       "Without a guess, the lens chosen by held-out folds (lens='auto'): dict candidates, held_out_rms_px (per "
       "candidate, NaN where it failed), held_out_corners, folds, chosen; None unless chosen.");
+  cls.def_property_readonly(
+      "tangential_choice",
+      [record, named_choice](const Holder& holder) { return named_choice(record(holder).tangential_choice); },
+      "Whether a pinhole's p1, p2 are fitted, chosen by held-out folds (tangential='auto'): dict candidates (held, "
+      "fitted), held_out_rms_px, held_out_corners, folds, chosen; None unless chosen.");
   cls.def_property_readonly(
       "holdout",
       [record](const Holder& holder) -> py::object {
@@ -386,7 +390,8 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
                         const std::vector<double>& distances_n, double max_predicted_error_px, double rim_field_deg,
                         int holdout, int holdout_folds, bool cross_validate, double cross_validation_distance_mm, bool board_warp,
                         bool view_weights, std::optional<bool> checkerboard_edges,
-                        const py::object& knots, const std::string& lens, py::object progress) {
+                        const py::object& knots, const std::string& lens, const std::string& tangential,
+                        py::object progress) {
   CalibrationInput input;
   PyTarget target = TargetOf(target_arg);
   input.target = std::move(target.board);
@@ -436,6 +441,7 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
     throw InputError("knots: expected a knot count (4..16) or 'auto', got " + TypeName(knots));
   }
   options.lens = lens;
+  options.tangential = tangential;
   options.cross_validate = cross_validate;
   options.cross_validation_distance_mm = cross_validation_distance_mm;
   options.progress = ForwardProgress(std::move(progress));
@@ -562,7 +568,7 @@ void BindDetections(py::module_& m) {
           "code", [](const CalibrationWarning& w) { return WarningCodeName(w.code); },
           "What kind: image_unreadable, image_size_differs, checkerboard_refused, view_skipped, tolerance_not_applicable, "
           "view_left_out, sensor_invalid, not_converged, free_gauge, weakly_determined, one_distance, tolerance_conflict, "
-          "tolerance_note, predicted_error_unknown, predicted_error_high, held_out_worse, knot_count_replaced, lens_not_chosen, "
+          "tolerance_note, predicted_error_unknown, predicted_error_high, held_out_worse, knot_count_replaced, lens_not_chosen, tangential_not_fitted, "
           "board_screen_stopped, image_rim_not_used.")
       .def_readonly("subject", &CalibrationWarning::subject, "The image or parameter it concerns ('' for the whole run).")
       .def_readonly("text", &CalibrationWarning::text, "The one-line message (what the CLI prints).")
@@ -714,7 +720,7 @@ are also attributes here), the warnings with their codes, the views and residual
         "distances_mm"_a = std::vector<double>(), "distances_n"_a = std::vector<double>(),
         "max_predicted_error_px"_a = 0.3, "rim_field_deg"_a = kDefaultRimFieldDeg, "holdout"_a = 0, "holdout_folds"_a = 0,
         "cross_validate"_a = false, "cross_validation_distance_mm"_a = 0.0, "board_warp"_a = false, "view_weights"_a = false,
-        "checkerboard_edges"_a = py::none(), "knots"_a = 0, "lens"_a = "", "progress"_a = py::none(),
+        "checkerboard_edges"_a = py::none(), "knots"_a = 0, "lens"_a = "", "tangential"_a = "", "progress"_a = py::none(),
         R"(Calibrates the sensor (as `omnical calibrate`) -> CalibrationResult.
 
 target: a Target or a spec path. Corners: images (as detect(): a directory or glob, a
@@ -722,9 +728,11 @@ list of paths or arrays, a dict name -> array) or detections (a Detections or a
 detections file), exactly one. guess: a Sensor or a sensor file (a file also brings its
 design tolerances, as --sensor); without one the fit starts from the mirror's rim circle
 (rim_field_deg: the rim ray's angle from the axis; lens: the lens it starts,
-'orthographic' ('' too), 'pinhole' or 'auto': chosen by held-out folds, result.lens_choice). profile: mirror family to fit
+'orthographic' ('' too), 'pinhole' or 'auto': chosen by held-out folds, result.lens_choice).
+tangential: a pinhole's p1, p2, 'off' ('' too: held), 'on' (fitted) or 'auto' (fitted where
+that predicts held-out folds better, result.tangential_choice). profile: mirror family to fit
 (one of omnical.PROFILES but tabulated; '' the guess's). fixed: blocks held (lens,
-lens_scale, principal_point, distortion, m, tilt, decenter, shape, poses; a list or 'a,b').
+lens_scale, principal_point, distortion, tangential, m, tilt, decenter, shape, poses; a list or 'a,b').
 loss_px: Huber scale (0: least squares). detection_passes: 2 re-detects through the
 first fit, 3 (aprilgrids) once more through the second. threads: detection, board checks and the fit's Jacobians, 0 for all cores
 (the same result for any count). leave_one_out: also fit without each view.

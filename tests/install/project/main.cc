@@ -15,7 +15,7 @@ int main() {
   model.pose = {4.110 * 43.9, 0.0, 0.0, 0.0, 0.0};  // m_mm, tilts, decenters
   const double rim_sag_mm = model.mirror.EvaluateSag(43.9 * 43.9).z;
   const double focal_px = 500.0 * (model.pose.m_mm + rim_sag_mm) / 43.9;  // the rim at 500 px
-  model.lens = {focal_px, focal_px, 499.5, 499.5, 0.0, 0.0};
+  model.lens = {focal_px, focal_px, 499.5, 499.5, 0.0, 0.0, 0.0, 0.0};
   model.image_width_px = model.image_height_px = 1000;
   const omnical::Sensor sensor(model);
 
