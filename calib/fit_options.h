@@ -118,7 +118,8 @@ struct FitOptions {
   // The gauge-fixing defaults for a sensor, from the registry's traits: an orthographic
   // lens holds m, decenter and its scale; a profile whose tilt is not observable (a
   // sphere: TiltObservable()) holds the tilt; free-form shape terms with a pinhole hold the
-  // distortion; a pinhole's tangential terms are held (they trade with tilt and decenter).
+  // distortion; a pinhole's tangential terms are held (they trade with decenter and the
+  // principal point).
   static FitOptions DefaultsFor(const Sensor& sensor);
   // Empty if valid, else "field: problem".
   std::string Check() const;

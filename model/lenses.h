@@ -23,7 +23,8 @@ namespace omnical {
 // the distortion is one-to-one (checked over the image by the sensor reader: the radial
 // part monotone; with p1, p2 also the whole map's Jacobian, model/sensor_validation.cc).
 // p1, p2 model a decentred lens element; the fit holds them unless asked or chosen by
-// held-out folds (calib/tangential_choice.h), since a lens tilt trades with the mirror's.
+// held-out folds (calib/tangential_choice.h): through the lens's narrow view of the mirror
+// their image shift trades with the mirror's decenter and the principal point.
 template <typename T>
 struct PinholeLens {
   static constexpr const char* kName = "pinhole";
@@ -36,8 +37,10 @@ struct PinholeLens {
        ScalarField("k1", "k1", ParameterGroup::kDistortion, false, FieldDomain::kBounded, 1e6, 0, true),
        ScalarField("k2", "k2", ParameterGroup::kDistortion, false, FieldDomain::kBounded, 1e6, 0, true),
        // Written only when not 0: files without them read the same in older versions.
-       OmittedWhenZero(ScalarField("p1", "p1", ParameterGroup::kTangential, false, FieldDomain::kBounded, 1.0, 0, true)),
-       OmittedWhenZero(ScalarField("p2", "p2", ParameterGroup::kTangential, false, FieldDomain::kBounded, 1.0, 0, true))}};
+       OmittedWhenZero(
+           ScalarField("p1", "p1", ParameterGroup::kTangential, false, FieldDomain::kBounded, 1.0, 0, true)),
+       OmittedWhenZero(
+           ScalarField("p2", "p2", ParameterGroup::kTangential, false, FieldDomain::kBounded, 1.0, 0, true))}};
   static constexpr bool kIsOrthographic = false;
   T fx_px, fy_px, cx_px, cy_px, k1, k2, p1, p2;
 
