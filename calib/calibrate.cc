@@ -347,8 +347,11 @@ std::string CalibrationOptions::Check() const {
     return "lens: the rim circle starts an orthographic or a pinhole lens, or 'auto' (got '" + lens + "')";
   if (!tangential.empty() && tangential != kTangentialOff && tangential != kTangentialOn && tangential != kChooseTangential)
     return "tangential: off, on or auto (got '" + tangential + "')";
-  if ((tangential == kTangentialOn || tangential == kChooseTangential) && (fixed.count("tangential") || fixed.count("lens")))
-    return "tangential/fixed: tangential " + tangential + " fits p1, p2, which fixed holds";
+  if (tangential == kTangentialOn || tangential == kChooseTangential) {
+    RefineOptions held;
+    held.Hold(fixed);  // an unknown name is the fit's error to report
+    if (!held.tangential) return "tangential/fixed: tangential " + tangential + " fits p1, p2, which fixed holds";
+  }
   if (!(loss_px >= 0.0 && std::isfinite(loss_px))) return "loss_px: must be >= 0 and finite";
   if (max_iterations < 1) return "max_iterations: must be >= 1";
   // Pass 2 re-detects through the first fit; an aprilgrid's later passes through the last.
@@ -608,8 +611,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
       fit_options = lens.options;
       views.poses = lens.initial_poses;
     }
-    const bool scored = std::any_of(choice.held_out_rms_px.begin(), choice.held_out_rms_px.end(),
-                                    [](double rms) { return std::isfinite(rms); });
+    const bool scored = choice.AnyScored();
     record.start = "rim circle, " + rim_profile + " mirror, " + choice.chosen + " lens" +
                    (scored ? " (chosen by held-out folds)" : "");
     if (!scored)
@@ -637,8 +639,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
                                       kTangentialScoreTolerance, input.target, views.detections, options.threads,
                                       "tangential", options.progress, {held_score, std::nullopt}));
     fit_options.refine.tangential = choice.chosen == kTangentialCandidates[1];
-    if (std::none_of(choice.held_out_rms_px.begin(), choice.held_out_rms_px.end(),
-                     [](double rms) { return std::isfinite(rms); }))
+    if (!choice.AnyScored())
       warnings.push_back({WarningCode::kTangentialNotFitted, "tangential",
                           "neither held nor fitted p1, p2 could be fitted to every held-out fold of the views; they "
                           "are held"});

@@ -1,7 +1,6 @@
 #include "calib/calibration_summary.h"
 
 #include <cstdarg>
-#include <cmath>
 #include <cstdio>
 
 namespace omnical {
@@ -28,13 +27,10 @@ void AppendFormatted(std::string& out, const char* format, ...) {
 void AppendNamedChoice(const char* what, const NamedChoice& choice, std::string* out) {
   *out += std::string(what) + " chosen by " + std::to_string(choice.folds) + " held-out folds (" +
           std::to_string(choice.held_out_corners) + " corners):";
-  bool scored = false;
-  for (size_t k = 0; k < choice.candidates.size(); ++k) {
-    scored |= std::isfinite(choice.held_out_rms_px[k]);
+  for (size_t k = 0; k < choice.candidates.size(); ++k)
     AppendFormatted(*out, " %s: %.4f px%s", choice.candidates[k].c_str(), choice.held_out_rms_px[k],
                     choice.candidates[k] == choice.chosen ? " (chosen)" : "");
-  }
-  *out += scored ? "\n" : " (none scored: the first kept)\n";
+  *out += choice.AnyScored() ? "\n" : " (none scored: the first kept)\n";
 }
 
 }  // namespace

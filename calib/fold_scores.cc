@@ -92,6 +92,10 @@ int PreferredCandidate(const std::vector<double>& held_out_rms_px, const std::ve
   return -1;
 }
 
+bool NamedChoice::AnyScored() const {
+  return std::any_of(held_out_rms_px.begin(), held_out_rms_px.end(), [](double rms) { return std::isfinite(rms); });
+}
+
 NamedChoice ChooseByHeldOutFolds(const std::vector<std::string>& names,
                                  const std::vector<std::optional<FoldCandidate>>& candidates, double tolerance,
                                  const CalibrationTarget& target, const DetectionSet& views, int threads,

@@ -53,6 +53,8 @@ struct NamedChoice {
   int held_out_corners = 0;
   int folds = 0;
   std::string chosen;  // the first candidate where none scored
+
+  bool AnyScored() const;
 };
 
 // A score measured before on the same views and folds, reused instead of refitting.

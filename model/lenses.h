@@ -66,7 +66,7 @@ struct PinholeLens {
 
   bool HasTangential() const { return ScalarPart(p1) != 0.0 || ScalarPart(p2) != 0.0; }
 
-  // d(x', y') / d(x, y) at an undistorted point, in double; its inverse applied to a vector.
+  // d(x', y') / d(x, y) at an undistorted point, in double.
   Eigen::Matrix2d DistortionJacobian(double x, double y) const {
     const double a = ScalarPart(k1), b = ScalarPart(k2), t1 = ScalarPart(p1), t2 = ScalarPart(p2);
     const double r2 = x * x + y * y;
@@ -79,10 +79,12 @@ struct PinholeLens {
         radial + radial_slope * y * y + 6.0 * t1 * y + 2.0 * t2 * x;
     return jacobian;
   }
-  static Eigen::Vector2d SolveJacobian(const Eigen::Matrix2d& jacobian, const Eigen::Vector2d& vector) {
+  // J^-1 v for that Jacobian; v may be a Jet's (its derivative parts are carried through).
+  template <typename U>
+  static Vec2<U> SolveJacobian(const Eigen::Matrix2d& jacobian, const Vec2<U>& vector) {
     const double det = jacobian(0, 0) * jacobian(1, 1) - jacobian(0, 1) * jacobian(1, 0);
-    return Eigen::Vector2d(jacobian(1, 1) * vector.x() - jacobian(0, 1) * vector.y(),
-                           jacobian(0, 0) * vector.y() - jacobian(1, 0) * vector.x()) / det;
+    return Vec2<U>((jacobian(1, 1) * vector(0) - jacobian(0, 1) * vector(1)) / det,
+                   (jacobian(0, 0) * vector(1) - jacobian(1, 0) * vector(0)) / det);
   }
 
   // Undistorted radius r for a distorted radius rd: safeguarded Newton on
@@ -148,15 +150,12 @@ struct PinholeLens {
     if constexpr (std::is_same_v<T, double>) {
       return point;
     } else {
-      const T x(point.x()), y(point.y());
-      T distorted_at_x, distorted_at_y;
-      Distort(x, y, &distorted_at_x, &distorted_at_y);
-      const T error_x = distorted_at_x - distorted_x, error_y = distorted_at_y - distorted_y;
-      // J^-1 error, with J in double: the Jets' derivative parts are carried by `error`.
-      const Eigen::Matrix2d jacobian = lens.DistortionJacobian(point.x(), point.y());
-      const double det = jacobian(0, 0) * jacobian(1, 1) - jacobian(0, 1) * jacobian(1, 0);
-      return Vec2<T>(x - (jacobian(1, 1) * error_x - jacobian(0, 1) * error_y) / det,
-                     y - (jacobian(0, 0) * error_y - jacobian(1, 0) * error_x) / det);
+      const Vec2<T> at(T(point.x()), T(point.y()));
+      Vec2<T> distorted;
+      Distort(at(0), at(1), &distorted(0), &distorted(1));
+      // With J in double: the Jets' derivative parts are carried by the error.
+      const Vec2<T> error(distorted(0) - distorted_x, distorted(1) - distorted_y);
+      return at - SolveJacobian(lens.DistortionJacobian(point.x(), point.y()), error);
     }
   }
 
