@@ -33,6 +33,20 @@ void AppendNamedChoice(const char* what, const NamedChoice& choice, std::string*
   *out += choice.AnyScored() ? "\n" : " (none scored: the first kept)\n";
 }
 
+// The knot counts as names ("4", "8"; the mirror family for no spline), to print as the
+// other choices print.
+NamedChoice NamedKnotChoice(const KnotChoice& knots) {
+  NamedChoice named;
+  for (int count : knots.candidates) {
+    named.candidates.push_back(count > 0 ? std::to_string(count) : knots.base_profile);
+    if (count == knots.chosen) named.chosen = named.candidates.back();
+  }
+  named.held_out_rms_px = knots.held_out_rms_px;
+  named.held_out_corners = knots.held_out_corners;
+  named.folds = knots.folds;
+  return named;
+}
+
 }  // namespace
 
 std::string CalibrationSummaryText(const CalibrationResult& result, const std::string& destination) {
@@ -57,15 +71,7 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
   if (const auto& warp = record.board_warp)
     AppendFormatted(out, "board warp: %.3f +- %.3f mm along x, %.3f +- %.3f mm along y (deflection at the centre)\n",
                     warp->warp.x_mm, warp->std_x_mm, warp->warp.y_mm, warp->std_y_mm);
-  if (const auto& knots = record.knot_choice) {
-    out += "knots chosen by " + std::to_string(knots->folds) + " held-out folds (" +
-           std::to_string(knots->held_out_corners) + " corners):";
-    for (size_t k = 0; k < knots->candidates.size(); ++k)
-      AppendFormatted(out, " %s: %.4f px%s",
-                      knots->candidates[k] > 0 ? std::to_string(knots->candidates[k]).c_str() : knots->base_profile.c_str(),
-                      knots->held_out_rms_px[k], knots->candidates[k] == knots->chosen ? " (chosen)" : "");
-    out += "\n";
-  }
+  if (const auto& knots = record.knot_choice) AppendNamedChoice("knots", NamedKnotChoice(*knots), &out);
   if (const auto& lens = record.lens_choice) AppendNamedChoice("lens", *lens, &out);
   if (const auto& tangential = record.tangential_choice) AppendNamedChoice("tangential terms p1, p2", *tangential, &out);
   if (const auto& held = record.holdout)

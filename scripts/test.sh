@@ -34,7 +34,12 @@ case $sanitize_pass in
   full) scope=(-DOMNICAL_CORE_ONLY=OFF) ;;
   *) echo "omnical: OMNICAL_SANITIZE_PASS must be core, full or 0, got '$sanitize_pass'" >&2; exit 2 ;;
 esac
+# Each phase's start in seconds since this script began: the CI log then says where its
+# time went (the CI budget is ~15 min on 2 cores).
+phase() { echo "omnical: [${SECONDS} s] $*"; }
+phase "dependencies"
 install_dependencies
+phase "Release build ($build_dir)"
 configure_and_build -DOMNICAL_BUILD_TESTS=ON -DOMNICAL_BUILD_BENCHMARKS=ON -DOMNICAL_WERROR=ON
 release_dir=$build_dir
 sanitize_dir=${OMNICAL_SANITIZE_BUILD_DIR:-$omnical_root/build/test-sanitize}
@@ -56,11 +61,15 @@ fi
 # The speed ratios (label bench) run alone, after the sanitizer build: measured with a
 # compiler on the other core, bench.projection_speed_ratio's axial sphere cost 20.3x its
 # baseline in one clean-clone CI run (bound 20x) against 11.2x on an idle machine.
+phase "Release tests (all but the label bench)"
 (cd "$release_dir" && ctest --output-on-failure -j "$jobs" -LE bench "$@")
 if [ "$sanitize_pass" = 0 ]; then
+  phase "speed ratios (label bench)"
   (cd "$release_dir" && ctest --output-on-failure -L bench "$@")
+  phase "done"
   exit 0
 fi
+phase "waiting for the sanitizer build"
 
 if ! wait "$sanitize_build"; then
   tail -40 "$sanitize_log" >&2
@@ -68,8 +77,9 @@ if ! wait "$sanitize_build"; then
   exit 1
 fi
 trap - EXIT
+phase "speed ratios (label bench)"
 (cd "$release_dir" && ctest --output-on-failure -L bench "$@")
-echo "omnical: second pass under AddressSanitizer + UndefinedBehaviorSanitizer ($sanitize_pass)"
+phase "second pass under AddressSanitizer + UndefinedBehaviorSanitizer ($sanitize_pass)"
 # Any report fails the test that triggered it: UBSan does not recover (compile flag), ASan
 # aborts, leaks count.
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1
@@ -86,3 +96,4 @@ if [ "$sanitize_pass" = full ]; then
   too_slow+='|RecoversTheTruthFromExactObservations/hyperboloid_pinhole_aligned|RecordRoundTripsThroughCalibrationJson'
 fi
 (cd "$sanitize_dir" && ctest --output-on-failure -j "$jobs" -LE 'bench|slow' -E "$too_slow" "$@")
+phase "done"
