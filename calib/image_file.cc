@@ -2,14 +2,13 @@
 
 #include <glob.h>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
 
 #include "model/input_error.h"
+#include "model/io/codecs/image_codecs.h"
 
 namespace omnical {
 
@@ -46,7 +45,7 @@ cv::Mat ReadImageFile(const std::string& path, int flags) {
         !std::equal(tail, tail + 12, kIend))
       return cv::Mat();
   }
-  return cv::imread(path, flags);
+  return LoadImageFile(path, flags);
 }
 
 }  // namespace omnical

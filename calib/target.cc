@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "model/io/atomic_write.h"
+#include "model/io/codecs/image_codecs.h"
 #include "model/input_error.h"
 #include "model/io/yaml_field_reader.h"
 
@@ -262,7 +263,7 @@ void CalibrationTarget::WritePng(const std::string& path, double dpi) const {
     }
   }
   std::vector<uchar> bytes;
-  cv::imencode(".png", image, bytes, {cv::IMWRITE_PNG_COMPRESSION, 9});
+  EncodeImage(".png", image, &bytes, {cv::IMWRITE_PNG_COMPRESSION, 9});
   WriteFileAtomically(path, [&](std::ostream& out) { out.write(reinterpret_cast<const char*>(bytes.data()), bytes.size()); });
 }
 

@@ -1,6 +1,5 @@
 #include "correction/unwarp.h"
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -17,6 +16,7 @@
 #include "correction/bilinear_remap.h"
 #include "correction/maps_json.h"
 #include "model/io/atomic_write.h"
+#include "model/io/codecs/image_codecs.h"
 #include "model/first_error.h"
 #include "model/forced_unwind.h"
 #include "model/input_error.h"
@@ -186,7 +186,7 @@ void WriteImageFile(const std::string& path, const cv::Mat& image) {
   const std::string extension = LowerExtension(path);
   bool encoded = false;
   try {
-    encoded = cv::imencode(extension.empty() ? ".png" : extension, image, bytes);
+    encoded = EncodeImage(extension.empty() ? ".png" : extension, image, &bytes);
   } catch (const cv::Exception&) {
   }
   if (!encoded) throw InputError(InputMessage(path, "", "cannot encode an image of this type (use .png, .jpg, .tif)"));

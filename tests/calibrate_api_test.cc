@@ -22,6 +22,7 @@
 #include "calib/image_file.h"
 #include "calib/synthetic/ground_truth.h"
 #include "model/input_error.h"
+#include "model/io/codecs/image_codecs.h"
 #include "synthetic_views.h"
 #include "test_sensors.h"
 #include "model/io/sensor_yaml.h"
@@ -291,7 +292,7 @@ TEST(CalibrateApi, DetectsImagesInMemoryAsFromFiles) {
       CalibrationTarget::FromYaml(testing::SourceDir() + "/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml");
   const std::vector<std::string> paths = {testing::SourceDir() + kSet + "/near000.png", testing::SourceDir() + kSet + "/near001.png"};
   std::vector<NamedImage> images;
-  for (const std::string& path : paths) images.push_back({path, cv::imread(path, cv::IMREAD_GRAYSCALE)});
+  for (const std::string& path : paths) images.push_back({path, omnical::LoadImageFile(path, cv::IMREAD_GRAYSCALE)});
   images.push_back({"blank", cv::Mat()});  // unreadable: skipped with a warning
   DetectionOptions options;
   const DetectedImages from_files = DetectImageFiles(target, paths, "two renders", options);
@@ -339,7 +340,7 @@ TEST(CalibrateApi, ARimCircleNotTheFitsRimIsReported) {
   CalibrationInput input = InputFromTruth();
   input.detections.reset();
   for (const char* view : {"near000.png", "near001.png", "near002.png", "near003.png"}) {
-    cv::Mat grey = cv::imread(testing::SourceDir() + kSet + "/" + view, cv::IMREAD_GRAYSCALE);
+    cv::Mat grey = omnical::LoadImageFile(testing::SourceDir() + kSet + "/" + view, cv::IMREAD_GRAYSCALE);
     cv::Mat hood(grey.size(), CV_8UC1, cv::Scalar(0));
     cv::circle(hood, cv::Point(529, 507), 400, cv::Scalar(255), cv::FILLED);  // the rim: r 500 px around it
     cv::Mat masked(grey.size(), CV_8UC1, cv::Scalar(0));

@@ -28,6 +28,7 @@
 #include "calib/refine_corners.h"
 #include "calib/tag_template_fit.h"
 #include "calib/synthetic/renderer.h"
+#include "model/io/codecs/image_codecs.h"
 #include "test_sensors.h"
 #include "model/io/sensor_yaml.h"
 
@@ -39,7 +40,7 @@ TEST(DetectAprilGrid, FindsEveryTagOfAMirroredPrintInPlace) {
   const std::string path = testing::PrivateTempDir() + "/mirrored_grid.png";
   const double dpi = 150.0;
   grid.WritePng(path, dpi);
-  cv::Mat print = cv::imread(path, cv::IMREAD_GRAYSCALE), mirrored;
+  cv::Mat print = omnical::LoadImageFile(path, cv::IMREAD_GRAYSCALE), mirrored;
   cv::flip(print, mirrored, 1);
   DetectionStats stats;
   const ImageDetections found = DetectAprilGrid(grid, mirrored, &stats);
@@ -70,7 +71,7 @@ TEST(DetectAprilGrid, RejectsTagsTheTargetDoesNotHave) {
   const CalibrationTarget printed = CalibrationTarget::AprilGrid(2, 2, 25.0, 0.3, "tag36h11", 40);
   const std::string path = testing::PrivateTempDir() + "/other_grid.png";
   printed.WritePng(path, 150.0);
-  cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  cv::Mat image = omnical::LoadImageFile(path, cv::IMREAD_GRAYSCALE);
   cv::flip(image, image, 1);
   DetectionStats stats;
   const ImageDetections found = DetectAprilGrid(CalibrationTarget::AprilGrid(2, 2, 25.0, 0.3), image, &stats);
@@ -158,7 +159,7 @@ TEST(DetectThroughVirtualViews, FindsFarTagsTheRawDetectorMisses) {
   int visible = 0, raw_found = 0, found = 0;
   double sum = 0.0;
   for (const ImageDetections& view : truth.images) {
-    const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+    const cv::Mat grey = omnical::LoadImageFile(view.image, cv::IMREAD_GRAYSCALE);
     const ImageDetections raw = DetectTarget(target, grey);
     const ImageDetections through = DetectThroughVirtualViews(target, grey, guess, raw);
     std::map<int, Eigen::Vector2d> expected;
@@ -198,7 +199,7 @@ TEST(DetectThroughVirtualViews, FindsCheckerboardsTheOmniSearchMissesByTheRimAnd
   double square_sum = 0.0, worst = 0.0;
   for (const ImageDetections& view : truth.images) {
     SCOPED_TRACE(view.image);
-    const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+    const cv::Mat grey = omnical::LoadImageFile(view.image, cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(grey.empty());
     const ImageDetections raw = DetectTarget(target, grey);
     EXPECT_TRUE(raw.corners.empty()) << "the omni search finds this board now: pick a harder view";
@@ -252,7 +253,7 @@ TEST(CompleteAprilGrid, PlacesTagsTooBlurredToDecode) {
   double square_sum = 0.0, worst = 0.0, worst_unrefined = 0.0;
   for (const ImageDetections& view : truth.images) {
     SCOPED_TRACE(view.image);
-    const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+    const cv::Mat grey = omnical::LoadImageFile(view.image, cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(grey.empty());
     const ImageDetections through = DetectThroughVirtualViews(target, grey, guess, DetectTarget(target, grey));
     const ImageDetections completed = RefineCorners(target, grey, &guess, through);
@@ -309,7 +310,7 @@ TEST(RefineCorners, BringsAprilGridCornersUnderATenthOfAPixel) {
   double before = 0.0, after = 0.0;
   int total = 0;
   for (const ImageDetections& view : truth.images) {
-    const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+    const cv::Mat grey = omnical::LoadImageFile(view.image, cv::IMREAD_GRAYSCALE);
     const ImageDetections through = DetectThroughVirtualViews(target, grey, guess, DetectTarget(target, grey));
     CornerRefinementStats stats;
     const ImageDetections refined = RefineCorners(target, grey, &guess, through, &stats);
@@ -359,7 +360,7 @@ TEST(TagTemplateFit, PutsTagCornersOnTheTruthMidFieldAndAtTheRim) {
   for (size_t v = 0; v < truth.images.size(); ++v) {
     const ImageDetections& view = truth.images[v];
     SCOPED_TRACE(view.image);
-    const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+    const cv::Mat grey = omnical::LoadImageFile(view.image, cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(grey.empty());
     std::map<int, Eigen::Vector2d> expected = PixelsById(view);
     double square_sum = 0.0;
@@ -422,7 +423,7 @@ TEST(TagTemplateFit, MovesAsFarAsItIsAllowed) {
   const CalibrationTarget target = CalibrationTarget::FromYaml(truth.target_spec);
   const BoardWarp warp{3.0, -1.5};
   const ImageDetections& view = truth.images[0];
-  const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+  const cv::Mat grey = omnical::LoadImageFile(view.image, cv::IMREAD_GRAYSCALE);
   ASSERT_FALSE(grey.empty());
   std::map<int, Eigen::Vector2d> expected = PixelsById(view);
   const std::array<double, 4> detector_bound = {kDetectorCornerMaxMoveCells, kDetectorCornerMaxMoveCells,
@@ -479,7 +480,7 @@ TEST(TagTemplateFit, KeepsRimCornersByTheRimItFitted) {
     const std::string name = view.name.substr(view.name.size() - 4);
     if (name != "rim0" && name != "rim1") continue;
     SCOPED_TRACE(name);
-    const cv::Mat grey = cv::imread(set + "/" + name + ".jpg", cv::IMREAD_GRAYSCALE);
+    const cv::Mat grey = omnical::LoadImageFile(set + "/" + name + ".jpg", cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(grey.empty());
     const CalibrationTarget& target = *view.targets[0].target;
     const BoardWarp warp = view.targets[0].surface.warp;
@@ -547,7 +548,7 @@ TEST(CheckerJunctionFit, PutsRimJunctionsTheRimCutsOnTheTruth) {
   for (size_t v = 0; v < truth.images.size(); ++v) {
     const ImageDetections& view = truth.images[v];
     SCOPED_TRACE(view.image);
-    const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+    const cv::Mat grey = omnical::LoadImageFile(view.image, cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(grey.empty());
     std::map<int, Eigen::Vector2d> expected = PixelsById(view);
     std::vector<int> junctions = rim_junctions[v];
@@ -594,7 +595,7 @@ TEST(CheckerJunctionFit, PutsRimJunctionsTheRimCutsOnTheTruth) {
   {
     const int covered = 3 * target.cols() + 3;
     ASSERT_TRUE(found.count(covered) && found.count(covered + 1));
-    cv::Mat fingered = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+    cv::Mat fingered = omnical::LoadImageFile(view.image, cv::IMREAD_GRAYSCALE);
     const double square_px = (found[covered + 1] - found[covered]).norm();
     cv::circle(fingered, cv::Point(static_cast<int>(std::lround(found[covered].x())), static_cast<int>(std::lround(found[covered].y()))),
                static_cast<int>(std::lround(0.3 * square_px)), cv::Scalar(150), cv::FILLED);
@@ -620,7 +621,7 @@ TEST(RefineCorners, SharpensCheckerboardCornersWithAndWithoutAGuess) {
   const DetectionSet truth = DetectionsFromGroundTruth({set + "/cb000.json"});
   const CalibrationTarget target = CalibrationTarget::FromYaml(truth.target_spec);
   const Sensor guess = LoadSensorYaml(set + "/sensor.yaml");
-  const cv::Mat grey = cv::imread(truth.images[0].image, cv::IMREAD_GRAYSCALE);
+  const cv::Mat grey = omnical::LoadImageFile(truth.images[0].image, cv::IMREAD_GRAYSCALE);
   const ImageDetections raw = DetectTarget(target, grey);
   ASSERT_EQ(raw.corners.size(), 48u);
   // Checkerboard ids hold up to the 180 deg symmetry: compare by nearest truth corner.
@@ -647,7 +648,7 @@ TEST(RefineCorners, ConvergesFromAPixelOffOrKeepsTheStart) {
   const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/ohte-sph-near";
   const DetectionSet truth = DetectionsFromGroundTruth({set + "/near000.json"});
   const CalibrationTarget target = CalibrationTarget::FromYaml(truth.target_spec);
-  const cv::Mat grey = cv::imread(truth.images[0].image, cv::IMREAD_GRAYSCALE);
+  const cv::Mat grey = omnical::LoadImageFile(truth.images[0].image, cv::IMREAD_GRAYSCALE);
   ImageDetections shifted = truth.images[0];
   for (CornerObservation& c : shifted.corners) c.pixel += Eigen::Vector2d(0.8, -0.6);
   CornerRefinementStats stats;
@@ -771,7 +772,7 @@ TEST(RefineCorners, CheckerboardEdgesLeaveNoRadialBias) {
   const Sensor sensor = LoadSensorYaml(set + "/sensor.yaml");
   for (const ImageDetections& view : truth.images) {
     SCOPED_TRACE(view.image);
-    const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+    const cv::Mat grey = omnical::LoadImageFile(view.image, cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(grey.empty());
     ImageDetections start = view;
     for (CornerObservation& c : start.corners) c.pixel += Eigen::Vector2d(0.4, -0.3);
@@ -1007,7 +1008,7 @@ TEST(DetectCheckerboard, PutsAShearedBoardsEdgeCornersOnTheirJunctions) {
     SCOPED_TRACE(view);
     const DetectionSet truth = DetectionsFromGroundTruth({sets + view});
     const CalibrationTarget target = CalibrationTarget::FromYaml(truth.target_spec);
-    const cv::Mat grey = cv::imread(truth.images[0].image, cv::IMREAD_GRAYSCALE);
+    const cv::Mat grey = omnical::LoadImageFile(truth.images[0].image, cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(grey.empty());
     const ImageDetections found = DetectTarget(target, grey);
     EXPECT_EQ(found.corners.size(), truth.images[0].corners.size());

@@ -21,6 +21,7 @@
 #include "calib/image_file.h"
 #include "calib/initial_sensor.h"
 #include "calib/rim_circle.h"
+#include "model/io/codecs/image_codecs.h"
 #include "test_sensors.h"
 
 namespace omnical {
@@ -52,7 +53,7 @@ TEST(RealImages, MeiParabolicDetectsAndCalibrates) {
   for (int k = 1; k <= 10; ++k) {
     char name[32];
     std::snprintf(name, sizeof name, "img_para_%03d.pgm", k);
-    const cv::Mat grey = cv::imread(kData + "/" + name, cv::IMREAD_GRAYSCALE);
+    const cv::Mat grey = omnical::LoadImageFile(kData + "/" + name, cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(grey.empty()) << name;
     detections.image_width_px = grey.cols;
     detections.image_height_px = grey.rows;
@@ -77,7 +78,7 @@ TEST(RealImages, MeiParabolicDetectsAndCalibrates) {
   // paraboloid) with an orthographic lens, scale held.
   std::vector<RimCircle> circles;
   for (const ImageDetections& image : detections.images)
-    if (auto circle = DetectRimCircle(cv::imread(kData + "/" + image.image, cv::IMREAD_GRAYSCALE))) circles.push_back(*circle);
+    if (auto circle = DetectRimCircle(omnical::LoadImageFile(kData + "/" + image.image, cv::IMREAD_GRAYSCALE))) circles.push_back(*circle);
   ASSERT_EQ(circles.size(), 10u);
   const RimCircle rim = *MedianRimCircle(circles);
   for (const auto& [profile, rms_bound] :

@@ -12,6 +12,7 @@
 
 #include "calib/bundle_fit.h"
 #include "calib/rim_circle.h"
+#include "model/io/codecs/image_codecs.h"
 #include "test_sensors.h"
 #include "model/io/sensor_yaml.h"
 
@@ -39,7 +40,7 @@ TEST(RimCircle, FindsTheRimOfARenderedMirror) {
   for (const std::string view : {"ohte-sph-near/near000.png", "ohte-sph-far/far002.png", "ohte-edi-near/near001.png"}) {
     const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/" + view.substr(0, view.find('/'));
     const Sensor sensor = LoadSensorYaml(set + "/sensor.yaml");
-    const cv::Mat grey = cv::imread(testing::SourceDir() + "/datasets-synthetic/rendered/" + view, cv::IMREAD_GRAYSCALE);
+    const cv::Mat grey = omnical::LoadImageFile(testing::SourceDir() + "/datasets-synthetic/rendered/" + view, cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(grey.empty()) << view;
     const auto circle = DetectRimCircle(grey);
     ASSERT_TRUE(circle) << view;
@@ -68,7 +69,7 @@ TEST(RimCircle, AgreesAcrossTheRealImages) {
   for (int k = 1; k <= 10; ++k) {
     char name[32];
     std::snprintf(name, sizeof name, "/img_para_%03d.pgm", k);
-    const auto circle = DetectRimCircle(cv::imread(data + name, cv::IMREAD_GRAYSCALE));
+    const auto circle = DetectRimCircle(omnical::LoadImageFile(data + name, cv::IMREAD_GRAYSCALE));
     ASSERT_TRUE(circle) << name;
     circles.push_back(*circle);
   }
@@ -90,7 +91,7 @@ TEST(RimCircle, AgreesAcrossTheRealImages) {
 TEST(RimCircle, MovesASensorsRimOntoTheImages) {
   const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/realistic-aprilgrid";
   const Sensor truth = LoadSensorYaml(set + "/sensor.yaml");
-  const auto circle = DetectRimCircle(cv::imread(set + "/rim0.jpg", cv::IMREAD_GRAYSCALE));
+  const auto circle = DetectRimCircle(omnical::LoadImageFile(set + "/rim0.jpg", cv::IMREAD_GRAYSCALE));
   ASSERT_TRUE(circle);
   for (const double factor : {0.96, 1.04}) {
     const Sensor off = SensorWithWiderRim(truth, factor);

@@ -12,6 +12,7 @@
 
 #include "calib/target.h"
 #include "model/input_error.h"
+#include "model/io/codecs/image_codecs.h"
 #include "test_sensors.h"
 
 namespace omnical {
@@ -39,7 +40,7 @@ TEST(Target, PrintedAprilGridDecodesToItsIdsInPlace) {
         CalibrationTarget::AprilGrid(4, 3, 25.0, std::string(family) == "tag36h11" ? 0.3 : 1.0, family, 10);
     const std::string path = testing::PrivateTempDir() + "/grid.png";
     grid.WritePng(path, 100.0);
-    cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    cv::Mat image = omnical::LoadImageFile(path, cv::IMREAD_GRAYSCALE);
     ASSERT_FALSE(image.empty());
     image_u8_t frame{image.cols, image.rows, static_cast<int32_t>(image.step), image.data};
     apriltag_family_t* fam = std::string(family) == "tag36h11" ? tag36h11_create() : tagStandard41h12_create();

@@ -1,7 +1,5 @@
 #include "tools/cli_common.h"
 
-#include <opencv2/imgcodecs.hpp>
-
 #include <cstdio>
 #include <iostream>
 

@@ -1,17 +1,17 @@
 // omnical unwarp: an omni image or video through a remap table (from `remap --out DIR`, or
 // made on the fly from view options) to the virtual screen (correction/unwarp.h). Video
-// files are opened here (cv::VideoCapture/VideoWriter); the library holds the frame loop.
+// files are opened here (model/io/codecs: OpenCV's videoio); the library holds the frame loop.
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/videoio.hpp>
-#include <opencv2/videoio/registry.hpp>
 
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 
 #include "correction/unwarp.h"
 #include "model/io/atomic_write.h"
+#include "model/io/codecs/image_codecs.h"
 #include "model/input_error.h"
 #include "tools/commands.h"
 #include "tools/progress.h"
@@ -43,8 +43,9 @@ Unwarper MakeUnwarper(const UnwarpFlags& options, const ProgressCallback& progre
 
 // The video through the unwarper into options.out (MJPG .avi or mp4v .mp4), atomically.
 long UnwarpVideo(const Unwarper& unwarper, const UnwarpFlags& options, const ProgressCallback& progress) {
-  // Checked here, and read through FFmpeg alone: OpenCV otherwise tries GStreamer and an
-  // image-sequence reader first, and each failure printed several lines before our one.
+  // Checked here, and read through FFmpeg alone (OpenVideoFile): OpenCV otherwise tries
+  // GStreamer and an image-sequence reader first, and each failure printed several lines
+  // before our one.
   std::error_code error;
   if (!std::filesystem::exists(options.input, error)) throw InputError(InputMessage(options.input, "", "file not found"));
   if (!std::filesystem::is_regular_file(options.input, error))
@@ -55,30 +56,29 @@ long UnwarpVideo(const Unwarper& unwarper, const UnwarpFlags& options, const Pro
   // FFmpeg's own messages on a corrupt file ("[png @ 0x...] chunk too big") too, unless
   // the user asked for them: OpenCV reads this when it first starts FFmpeg.
   ::setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);  // AV_LOG_QUIET
-  cv::VideoCapture capture(options.input,
-                           cv::videoio_registry::hasBackend(cv::CAP_FFMPEG) ? cv::CAP_FFMPEG : cv::CAP_ANY);
-  if (!capture.isOpened()) throw InputError(InputMessage(options.input, "", "cannot be opened as a video"));
+  const std::unique_ptr<VideoFrameReader> capture = OpenVideoFile(options.input);
+  if (!capture) throw InputError(InputMessage(options.input, "", "cannot be opened as a video"));
   const std::string extension = LowerExtension(options.out);
-  const int fourcc = extension == ".avi" ? cv::VideoWriter::fourcc('M', 'J', 'P', 'G')
-                     : extension == ".mp4" || extension == ".m4v" || extension == ".mov"
-                         ? cv::VideoWriter::fourcc('m', 'p', '4', 'v')
-                         : 0;
+  const int fourcc = extension == ".avi"                                              ? VideoFourcc('M', 'J', 'P', 'G')
+                     : extension == ".mp4" || extension == ".m4v" || extension == ".mov" ? VideoFourcc('m', 'p', '4', 'v')
+                                                                                         : 0;
   if (fourcc == 0) throw InputError(InputMessage(options.out, "", "video output must be .avi (MJPG) or .mp4 (mp4v)"));
-  double fps = capture.get(cv::CAP_PROP_FPS);
+  double fps = capture->FramesPerSecond();
   if (!(fps > 0.0 && fps < 1000.0)) fps = 25.0;
-  const long total = std::max(1L, static_cast<long>(capture.get(cv::CAP_PROP_FRAME_COUNT)));
+  const long total = std::max(1L, capture->FrameCount());
   long frames = 0;
   // The container is chosen by the file name, which the temporary file keeps.
   WriteFileAtomicallyByPath(options.out, [&](const std::string& temporary) {
-    cv::VideoWriter writer;
+    std::unique_ptr<VideoFrameWriter> writer;
     auto write = [&](const cv::Mat& frame) {
-      if (!writer.isOpened() &&
-          !writer.open(temporary, fourcc, fps, cv::Size(unwarper.width_px(), unwarper.height_px()), frame.channels() == 3))
+      if (!writer &&
+          !(writer = CreateVideoFile(temporary, fourcc, fps, cv::Size(unwarper.width_px(), unwarper.height_px()),
+                                     frame.channels() == 3)))
         throw InputError(InputMessage(options.out, "", "cannot be written as a video"));
-      writer.write(frame);
+      writer->Write(frame);
     };
-    frames = UnwarpFrames(unwarper, [&](cv::Mat* frame) { return capture.read(*frame); }, write, total, options.input, progress);
-    writer.release();
+    frames = UnwarpFrames(unwarper, [&](cv::Mat* frame) { return capture->Read(frame); }, write, total, options.input, progress);
+    if (writer) writer->Close();
   });
   return frames;
 }

@@ -10,6 +10,7 @@
 #include <mutex>
 
 #include "model/io/atomic_write.h"
+#include "model/io/codecs/image_codecs.h"
 #include "model/input_error.h"
 
 namespace omnical {
@@ -252,8 +253,8 @@ void WritePng(const std::string& path, const cv::Mat& image) {
   // also makes libpng try every filter on every row, which was most of `calibrate
   // --detections` on the real dev set.
   const bool large = image.total() > 500000;
-  const bool encoded = large ? cv::imencode(".png", image, bytes)
-                             : cv::imencode(".png", image, bytes, {cv::IMWRITE_PNG_COMPRESSION, 9});
+  const bool encoded = large ? EncodeImage(".png", image, &bytes)
+                             : EncodeImage(".png", image, &bytes, {cv::IMWRITE_PNG_COMPRESSION, 9});
   if (!encoded) throw InputError(InputMessage(path, "", "cannot encode PNG"));
   WriteFileAtomically(path, [&](std::ostream& out) { out.write(reinterpret_cast<const char*>(bytes.data()), bytes.size()); });
 }

@@ -16,6 +16,7 @@
 #include "calib/synthetic/ground_truth.h"
 #include "calib/refine_corners.h"
 #include "model/io/atomic_write.h"
+#include "model/io/codecs/image_codecs.h"
 #include "model/io/sensor_yaml.h"
 
 int main() {
@@ -76,7 +77,7 @@ int main() {
       double unrefined_square_sum = 0.0;
       double seconds = 0.0;
       for (const ImageDetections& view : truth.images) {
-        const cv::Mat grey = cv::imread(view.image, cv::IMREAD_GRAYSCALE);
+        const cv::Mat grey = omnical::LoadImageFile(view.image, cv::IMREAD_GRAYSCALE);
         const auto start = std::chrono::steady_clock::now();
         ImageDetections detected = DetectTarget(target, grey);
         if (through_views) detected = DetectThroughVirtualViews(target, grey, guess, detected);

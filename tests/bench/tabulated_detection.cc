@@ -24,6 +24,7 @@
 
 #include "calib/image_detection.h"
 #include "calib/target.h"
+#include "model/io/codecs/image_codecs.h"
 #include "model/io/sensor_yaml.h"
 #include "model/sensor.h"
 
@@ -80,7 +81,7 @@ int main(int argc, char** argv) {
       CalibrationTarget::FromYaml(kSource + "/datasets-synthetic/targets/aprilgrid-6x6-30mm.yaml");
   std::vector<NamedImage> images;
   for (const auto& entry : std::filesystem::directory_iterator(rendered))
-    if (entry.path().extension() == ".png") images.push_back({entry.path().string(), cv::imread(entry.path().string(), cv::IMREAD_GRAYSCALE)});
+    if (entry.path().extension() == ".png") images.push_back({entry.path().string(), omnical::LoadImageFile(entry.path().string(), cv::IMREAD_GRAYSCALE)});
   std::sort(images.begin(), images.end(), [](const NamedImage& a, const NamedImage& b) { return a.name < b.name; });
 
   auto detect = [&](const Sensor& guess, DetectionSet* found) {

@@ -26,6 +26,14 @@ expect_error() {
 }
 
 # --- happy paths -------------------------------------------------------------------
+# Projecting points needs no image codecs: OpenCV's imgcodecs and videoio (with the ~240
+# libraries they bring) are loaded only when a file of pixels is read or written
+# (model/io/codecs/image_codecs.h).
+if ldd "$omnical" | grep -qE "libopencv_(imgcodecs|videoio)"; then
+  fail "the CLI links OpenCV's imgcodecs or videoio: $(ldd "$omnical" | grep -E "libopencv_(imgcodecs|videoio)" | tr -s ' \n' ' ')"
+else
+  pass
+fi
 cat >"$work/pixels.csv" <<'CSV'
 # pixels of the seed SPH sensor: centre, mid-field, rim, a corner
 u,v

@@ -25,10 +25,20 @@ passed=0
 prefix=$work/prefix
 run cmake --install "$build_dir" --prefix "$prefix"
 test -x "$prefix/bin/omnical" || fail "no installed omnical binary"
+# The image codecs plugin, loaded on first use (model/io/codecs/image_codecs.h).
+plugin=$(find "$prefix" -path "*/omnical/libomnical_codecs_plugin.so" | head -1)
+[ -n "$plugin" ] || fail "no installed codecs plugin (<libdir>/omnical/libomnical_codecs_plugin.so)"
+# ... and the installed CLI loads that one (beside it), not the build tree's, when it first
+# writes an image.
+LD_DEBUG=files "$prefix/bin/omnical" -q target --spec "$data/targets/aprilgrid-6x6-30mm.yaml" --dpi 20 \
+  --out "$work/target.png" 2>"$work/loader.log" || { tail -5 "$work/loader.log"; fail "installed omnical target"; }
+grep -q "file=$plugin " "$work/loader.log" ||
+  fail "the installed CLI did not load $plugin: $(grep -o 'file=[^ ]*codecs_plugin[^ ]*' "$work/loader.log" | head -1)"
+passed=$((passed + 1))
 
 # Public headers only: the internal ones stay in the source tree.
 for internal in calib/bilinear.h calib/refine_corners.h calib/virtual_view.h correction/parallel_rows.h \
-                model/io/yaml_field_reader.h tools/cli_common.h; do
+                model/io/yaml_field_reader.h model/io/codecs/codecs_plugin_table.h tools/cli_common.h; do
   [ ! -e "$prefix/include/omnical/$internal" ] || fail "internal header installed: $internal"
 done
 # ... and every installed header compiles on its own terms (one unit including them all).
@@ -91,15 +101,22 @@ if [ -n "$python" ]; then
   for file in __init__.py _omnical.pyi py.typed; do test -f "$site/omnical/$file" || fail "python: $file not installed"; done
   printf '400,-150,60\n' >"$work/point.csv"
   expected=$("$prefix/bin/omnical" project --sensor "$data/sensors/ohte-sph.yaml" --points "$work/point.csv" | tail -1)
-  (cd "$work" && PYTHONPATH="$site" "$python" - "$data/sensors/ohte-sph.yaml" "$expected" "$site") <<'PY' || fail "python: the installed package"
+  (cd "$work" && PYTHONPATH="$site" "$python" - "$data/sensors/ohte-sph.yaml" "$expected" "$site" \
+     "$data/targets/aprilgrid-6x6-30mm.yaml" "$data/rendered/ohte-sph-near/near000.png" "$plugin") <<'PY' ||
+    fail "python: the installed package"
+import os
 import sys
 import omnical
-sensor_path, expected, site = sys.argv[1:]
+sensor_path, expected, site, target, image, plugin = sys.argv[1:]
 assert omnical.__file__.startswith(site), omnical.__file__
 pixels, status = omnical.Sensor.load(sensor_path).project([[400.0, -150.0, 60.0]])
 u, v, name = expected.split(",")
 assert omnical.status_name(status[0]) == name, (status, expected)
 assert abs(pixels[0, 0] - float(u)) < 1e-9 and abs(pixels[0, 1] - float(v)) < 1e-9, (pixels, expected)
+# Reading an image loads the installed codecs plugin, not the build tree's.
+assert omnical.detect(target, [image], threads=1).images[0].ids.size > 0
+mapped = {line.split()[-1] for line in open("/proc/self/maps") if "libomnical_codecs_plugin" in line}
+assert mapped == {os.path.realpath(plugin)}, (mapped, plugin)
 PY
   passed=$((passed + 1))
 fi

@@ -1,0 +1,29 @@
+// What libomnical_codecs_plugin.so hands the loader (image_codecs.cc): one table of entry
+// points, built by the same compiler and against the same OpenCV as the code calling it.
+// The version changes with the table, so an older plugin found first is skipped.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "model/io/codecs/image_codecs.h"
+
+namespace omnical {
+
+constexpr int kCodecsPluginTableVersion = 1;
+
+struct CodecsPluginTable {
+  int version;
+  cv::Mat (*load_image)(const std::string& path, int imread_flags);
+  bool (*encode_image)(const std::string& extension, const cv::Mat& image, std::vector<unsigned char>* bytes,
+                       const std::vector<int>& imwrite_params);
+  std::unique_ptr<VideoFrameReader> (*open_video)(const std::string& path);
+  std::unique_ptr<VideoFrameWriter> (*create_video)(const std::string& path, int fourcc, double frames_per_second,
+                                                    cv::Size frame_size, bool colour);
+};
+
+}  // namespace omnical
+
+// The plugin's one exported symbol.
+extern "C" const omnical::CodecsPluginTable* omnical_codecs_plugin_table();
