@@ -2,11 +2,12 @@
 
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <mutex>
-#include <stdexcept>
 
+#include "model/input_error.h"
 #include "model/io/codecs/codecs_plugin_table.h"
 
 namespace omnical {
@@ -23,15 +24,16 @@ constexpr char kPluginFile[] = "libomnical_codecs_plugin.so";
 std::vector<std::string> PluginCandidates() {
   std::vector<std::string> candidates;
   if (const char* named = std::getenv("OMNICAL_CODECS_PLUGIN"); named && *named) candidates.push_back(named);
-  // The program's own directory (for the main program dladdr gives only argv[0]), and
-  // that of the module holding this code where it is another (the Python extension).
+  // The program's own directory (for the main program dladdr gives only argv[0], perhaps
+  // relative to a directory since left), and that of the module holding this code where it
+  // is another (the Python extension, loaded by its absolute path).
   std::vector<std::filesystem::path> directories;
   std::error_code error;
   const std::filesystem::path program = std::filesystem::read_symlink("/proc/self/exe", error);
   if (!error) directories.push_back(program.parent_path());
   Dl_info info{};
   if (::dladdr(reinterpret_cast<void*>(&PluginCandidates), &info) != 0 && info.dli_fname != nullptr &&
-      std::string(info.dli_fname).find('/') != std::string::npos) {
+      info.dli_fname[0] == '/') {
     const std::filesystem::path module = std::filesystem::path(info.dli_fname).parent_path();
     if (directories.empty() || module != directories.front()) directories.push_back(module);
   }
@@ -43,7 +45,11 @@ std::vector<std::string> PluginCandidates() {
   candidates.push_back(OMNICAL_CODECS_INSTALL_DIR "/" + std::string(kPluginFile));
   candidates.push_back(OMNICAL_CODECS_BUILD_DIR "/" + std::string(kPluginFile));
   candidates.push_back(kPluginFile);
-  return candidates;
+  // Directories above / collapse to the same path: each tried once, in order.
+  std::vector<std::string> unique;
+  for (const std::string& candidate : candidates)
+    if (std::find(unique.begin(), unique.end(), candidate) == unique.end()) unique.push_back(candidate);
+  return unique;
 }
 
 const CodecsPluginTable& Plugin() {
@@ -68,10 +74,13 @@ const CodecsPluginTable& Plugin() {
       }
       tried += (tried.empty() ? "" : ", ") + candidate + " (another version)";
     }
-    failure = std::string("image codecs: ") + kPluginFile + " (omnical's image and video file support) not found; "
-              "tried " + tried + "; set OMNICAL_CODECS_PLUGIN to its path";
+    // A missing file of the installation, named with the variable that points at it: an
+    // InputError, so the CLI exits 2 and Python raises omnical.InputError, as for any file.
+    failure = InputMessage("OMNICAL_CODECS_PLUGIN", "", std::string(kPluginFile) +
+                                                        " (omnical's image and video file support) not found; tried " +
+                                                        tried + "; set OMNICAL_CODECS_PLUGIN to its path");
   });
-  if (table == nullptr) throw std::runtime_error(failure);
+  if (table == nullptr) throw InputError(failure);
   return *table;
 }
 

@@ -5,6 +5,8 @@
 // program's), where projecting points or fitting detections never touches a file of
 // pixels (tests/bench/startup_cost.py). They live in a plugin, libomnical_codecs_plugin.so,
 // in <libdir>/omnical (found as image_codecs.cc says; OMNICAL_CODECS_PLUGIN names it).
+// Every function below throws InputError (naming OMNICAL_CODECS_PLUGIN and each path tried)
+// when the plugin cannot be found.
 #pragma once
 
 #include <opencv2/core.hpp>
