@@ -35,6 +35,25 @@ LD_DEBUG=files "$prefix/bin/omnical" -q target --spec "$data/targets/aprilgrid-6
 grep -q "file=$plugin " "$work/loader.log" ||
   fail "the installed CLI did not load $plugin: $(grep -o 'file=[^ ]*codecs_plugin[^ ]*' "$work/loader.log" | head -1)"
 passed=$((passed + 1))
+# The codecs component asked for alone configures, links and reads an image.
+mkdir "$work/codecs_only"
+cat >"$work/codecs_only/CMakeLists.txt" <<'CMAKE'
+cmake_minimum_required(VERSION 3.22)
+project(codecs_only LANGUAGES CXX)
+set(CMAKE_CXX_STANDARD 17)
+find_package(omnical 0.1 REQUIRED COMPONENTS codecs)
+add_executable(codecs_only main.cc)
+target_link_libraries(codecs_only PRIVATE omnical::codecs)
+CMAKE
+cat >"$work/codecs_only/main.cc" <<'CC'
+#include "model/io/codecs/image_codecs.h"
+int main(int, char** argv) { return omnical::LoadImageFile(argv[1], 0).cols == 1000 ? 0 : 1; }
+CC
+run cmake -S "$work/codecs_only" -B "$work/codecs_only/build" -G Ninja -DCMAKE_PREFIX_PATH="$prefix"
+run cmake --build "$work/codecs_only/build"
+"$work/codecs_only/build/codecs_only" "$data/rendered/ohte-sph-near/near000.png" ||
+  fail "codecs only: the image did not read as 1000 px wide"
+passed=$((passed + 1))
 
 # Public headers only: the internal ones stay in the source tree.
 for internal in calib/bilinear.h calib/refine_corners.h calib/virtual_view.h correction/parallel_rows.h \
