@@ -263,7 +263,8 @@ void CalibrationTarget::WritePng(const std::string& path, double dpi) const {
     }
   }
   std::vector<uchar> bytes;
-  EncodeImage(".png", image, &bytes, {cv::IMWRITE_PNG_COMPRESSION, 9});
+  if (!EncodeImage(".png", image, &bytes, {cv::IMWRITE_PNG_COMPRESSION, 9}))
+    throw InputError(InputMessage(path, "", "cannot encode PNG"));
   WriteFileAtomically(path, [&](std::ostream& out) { out.write(reinterpret_cast<const char*>(bytes.data()), bytes.size()); });
 }
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Fails when a source file includes a header from a layer it may not use (docs/layers.md),
-and when a front end stops being thin (a CLI subcommand over 150 lines, the CLI or the
+when code outside the codecs layer and the tests calls OpenCV's file codecs itself, and
+when a front end stops being thin (a CLI subcommand over 150 lines, the CLI or the
 Python module each over a quarter of the library).
 
 Usage: layers_test.py SOURCE_DIR            check the tree
@@ -74,6 +75,33 @@ def check(root, layers):
     return problems
 
 
+# OpenCV's imgcodecs and videoio are loaded on first use, by the codecs layer alone
+# (model/io/codecs/image_codecs.h): a direct call elsewhere would link them into every
+# process again. Their headers may still be included for the IMREAD_/IMWRITE_ constants.
+FILE_CODEC_CALL = re.compile(r"\bcv::(imread|imreadmulti|imwrite|imwritemulti|imencode|imdecode|haveImageReader|"
+                             r"haveImageWriter|VideoCapture|VideoWriter)\b")
+CODEC_USERS = ("codecs", "tests")
+
+
+def file_codecs_stay_in_their_layer(root, layers):
+    problems = []
+    for name, directory, _, _ in layers:
+        if name in CODEC_USERS:
+            continue
+        for folder, _, files in os.walk(os.path.join(root, directory)):
+            for file in files:
+                path = os.path.relpath(os.path.join(folder, file), root)
+                if not file.endswith((".h", ".cc")) or layer_of(path, layers)[0] != name:
+                    continue
+                with open(os.path.join(root, path), errors="replace") as f:
+                    for number, line in enumerate(f, 1):
+                        match = FILE_CODEC_CALL.search(line.split("//")[0])
+                        if match:
+                            problems.append(f"{path}:{number}: layer {name} calls {match.group(0)} "
+                                            "(through model/io/codecs/image_codecs.h only)")
+    return problems
+
+
 FRONT_ENDS = ("cli", "python")
 
 
@@ -120,8 +148,12 @@ def self_test(root, layers):
         open(os.path.join(tmp, "calib", "a.h"), "w").write("#pragma once\n")
         open(os.path.join(tmp, "correction", "b.cc"), "w").write('#include "calib/a.h"\n')
         open(os.path.join(tmp, "model", "c.cc"), "w").write("#include <opencv2/core.hpp>\n")
-        found = check(tmp, read_table(tmp))
-        expected = ["correction/b.cc: layer correction may not include calib/a.h (layer calib)",
+        open(os.path.join(tmp, "calib", "d.cc"), "w").write("// cv::imread is not called here\n"
+                                                            "cv::Mat image = cv::imread(path);\n")
+        table = read_table(tmp)
+        found = check(tmp, table) + file_codecs_stay_in_their_layer(tmp, table)
+        expected = ["calib/d.cc:2: layer calib calls cv::imread (through model/io/codecs/image_codecs.h only)",
+                    "correction/b.cc: layer correction may not include calib/a.h (layer calib)",
                     "model/c.cc: layer model may not use <opencv2/core.hpp> (opencv2)"]
         if sorted(found) != expected:
             sys.exit("layers_test self-test: expected %s, got %s" % (expected, found))
@@ -132,7 +164,7 @@ def main():
     layers = read_table(root)
     if "--self-test" in sys.argv:
         self_test(root, layers)
-    problems = check(root, layers)
+    problems = check(root, layers) + file_codecs_stay_in_their_layer(root, layers)
     thin, cli, library = front_end_is_thin(root, layers)
     problems += thin
     for p in problems:
@@ -140,7 +172,8 @@ def main():
     if problems:
         sys.exit(f"layers_test: {len(problems)} include(s) cross the layer table (docs/layers.md)")
     print(f"layers_test: {len(layers)} layers, every include allowed; tools/ {cli} lines, "
-          f"{100.0 * cli / library:.1f}% of the library's {library}; every subcommand under 150 lines")
+          f"{100.0 * cli / library:.1f}% of the library's {library}; every subcommand under 150 lines; "
+          "OpenCV's file codecs called only in the codecs layer")
 
 
 if __name__ == "__main__":

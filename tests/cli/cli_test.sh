@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # End-to-end checks of the omnical command line: results of project/unproject, and the
 # bad-input policy (exit code 2, exactly one line on stderr naming the file and field,
-# no output file left behind). Usage: cli_test.sh OMNICAL_BINARY SOURCE_DIR
+# no output file left behind).
+# Usage: cli_test.sh OMNICAL_BINARY SOURCE_DIR CODECS_PLUGIN_OF_ANOTHER_BUILD
 set -u
 omnical=$1
 source_dir=$(cd "$2" && pwd)
+other_build_plugin=$3
 sensors=$source_dir/datasets-synthetic/sensors
 source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
 
@@ -160,6 +162,14 @@ fi
   grep -aq "MediaBox \[0 0 688.818897" "$work/grid.pdf" && tail -c 6 "$work/grid.pdf" | grep -q "%%EOF" && pass ||
   fail "target pdf"
 expect_error target_format "unknown format '.jpg'" -- target --spec "$targets/aprilgrid-6x6-30mm.yaml" --out "$work/out.jpg"
+# OMNICAL_CODECS_PLUGIN names the one image codecs plugin to load (model/io/codecs/
+# image_codecs.h): a missing file, or the plugin of another build, is refused by name.
+OMNICAL_CODECS_PLUGIN=$work/no-plugin.so expect_error codecs_plugin_missing \
+  "OMNICAL_CODECS_PLUGIN: $work/no-plugin.so: no such file; it must name libomnical_codecs_plugin.so" -- \
+  target --spec "$targets/aprilgrid-6x6-30mm.yaml" --out "$work/out.csv.png"
+OMNICAL_CODECS_PLUGIN=$other_build_plugin expect_error codecs_plugin_of_another_build \
+  "OMNICAL_CODECS_PLUGIN: $other_build_plugin: from another build (another build of omnical; this program's: omnical " -- \
+  target --spec "$targets/aprilgrid-6x6-30mm.yaml" --out "$work/out.csv.png"
 
 cat >"$work/scene.yaml" <<YAML
 sensor: $sensors/ohte-sph.yaml

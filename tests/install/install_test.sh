@@ -32,8 +32,13 @@ plugin=$(find "$prefix" -path "*/omnical/libomnical_codecs_plugin.so" | head -1)
 # writes an image.
 LD_DEBUG=files "$prefix/bin/omnical" -q target --spec "$data/targets/aprilgrid-6x6-30mm.yaml" --dpi 20 \
   --out "$work/target.png" 2>"$work/loader.log" || { tail -5 "$work/loader.log"; fail "installed omnical target"; }
-grep -q "file=$plugin " "$work/loader.log" ||
-  fail "the installed CLI did not load $plugin: $(grep -o 'file=[^ ]*codecs_plugin[^ ]*' "$work/loader.log" | head -1)"
+# The plugin's own libraries are "needed by" the file the loader took, whichever way it was
+# named (a path, or a bare name searched through RUNPATH).
+loaded_plugin() {  # loaded_plugin WHO: $work/loader.log (LD_DEBUG=files) shows the installed plugin
+  grep -q "needed by $plugin " "$work/loader.log" ||
+    fail "$1: did not load $plugin: $(grep -o 'needed by [^ ]*codecs_plugin[^ ]*' "$work/loader.log" | head -1)"
+}
+loaded_plugin "the installed CLI"
 passed=$((passed + 1))
 # The codecs component asked for alone configures, links and reads an image.
 mkdir "$work/codecs_only"
@@ -51,8 +56,11 @@ int main(int, char** argv) { return omnical::LoadImageFile(argv[1], 0).cols == 1
 CC
 run cmake -S "$work/codecs_only" -B "$work/codecs_only/build" -G Ninja -DCMAKE_PREFIX_PATH="$prefix"
 run cmake --build "$work/codecs_only/build"
-"$work/codecs_only/build/codecs_only" "$data/rendered/ohte-sph-near/near000.png" ||
-  fail "codecs only: the image did not read as 1000 px wide"
+# ... through the installed plugin, which the package's RUNPATH finds for a program built
+# anywhere against a prefix installed anywhere (not the build tree's, not by walking up).
+LD_DEBUG=files "$work/codecs_only/build/codecs_only" "$data/rendered/ohte-sph-near/near000.png" \
+  2>"$work/loader.log" || fail "codecs only: the image did not read as 1000 px wide"
+loaded_plugin "codecs only"
 passed=$((passed + 1))
 
 # Public headers only: the internal ones stay in the source tree.

@@ -20,6 +20,33 @@ def run_child(code, *args, timeout=120):
                           text=True, timeout=timeout, env=os.environ)
 
 
+def test_a_missing_codecs_plugin_is_an_input_error_and_projection_still_works(data, tmp_path):
+    """OMNICAL_CODECS_PLUGIN names the one image codecs plugin to load: pointing nowhere,
+    reading an image raises InputError with the CLI's text; importing and projecting need
+    no plugin."""
+    missing = tmp_path / "no-plugin.so"
+    completed = subprocess.run([sys.executable, "-c", textwrap.dedent("""
+        import sys
+        import omnical
+        target, image, sensor = sys.argv[1:]
+        # Importing omnical loads none of OpenCV's file codecs.
+        assert "libopencv_imgcodecs" not in open("/proc/self/maps").read()
+        try:
+            omnical.detect(target, [image], threads=1)
+        except omnical.InputError as error:
+            print(error)
+        pixels, status = omnical.Sensor.load(sensor).project([[400.0, -150.0, 60.0]])
+        print(omnical.status_name(status[0]))
+        """), data / "targets" / "aprilgrid-6x6-30mm.yaml", data / "rendered" / "ohte-sph-near" / "near000.png",
+        data / "sensors" / "ohte-sph.yaml"], capture_output=True, text=True, timeout=120,
+        env={**os.environ, "OMNICAL_CODECS_PLUGIN": str(missing)})
+    assert completed.returncode == 0, completed.stderr
+    message, status = completed.stdout.splitlines()
+    assert message.startswith(f"OMNICAL_CODECS_PLUGIN: {missing}: no such file; it must name "
+                              "libomnical_codecs_plugin.so"), message
+    assert status == "ok", status
+
+
 def test_images_from_a_lazy_sequence_of_temporaries(data):
     """Each __getitem__ returns a new array that nothing else holds: the job must not keep
     pointers into it."""

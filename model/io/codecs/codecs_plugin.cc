@@ -4,10 +4,15 @@
 #include <opencv2/videoio.hpp>
 #include <opencv2/videoio/registry.hpp>
 
+#include <cmath>
+
 #include "model/io/codecs/codecs_plugin_table.h"
 
 namespace omnical {
 namespace {
+
+// A container's property as the reader promises it: 0 when unknown (NaN, infinite, negative).
+double KnownOrZero(double value) { return std::isfinite(value) && value > 0 ? value : 0.0; }
 
 class CaptureReader : public VideoFrameReader {
  public:
@@ -17,8 +22,12 @@ class CaptureReader : public VideoFrameReader {
       : capture_(path, cv::videoio_registry::hasBackend(cv::CAP_FFMPEG) ? cv::CAP_FFMPEG : cv::CAP_ANY) {}
   bool IsOpened() const { return capture_.isOpened(); }
   bool Read(cv::Mat* frame) override { return capture_.read(*frame); }
-  double FramesPerSecond() const override { return capture_.get(cv::CAP_PROP_FPS); }
-  long FrameCount() const override { return static_cast<long>(capture_.get(cv::CAP_PROP_FRAME_COUNT)); }
+  double FramesPerSecond() const override { return KnownOrZero(capture_.get(cv::CAP_PROP_FPS)); }
+  long FrameCount() const override {
+    // A broken container can report NaN or a huge count, whose cast to long is undefined.
+    const double count = KnownOrZero(capture_.get(cv::CAP_PROP_FRAME_COUNT));
+    return count < 1e15 ? static_cast<long>(count) : 0;
+  }
 
  private:
   cv::VideoCapture capture_;
@@ -56,7 +65,7 @@ std::unique_ptr<VideoFrameWriter> CreateVideo(const std::string& path, int fourc
   return writer;
 }
 
-const CodecsPluginTable kTable = {kCodecsPluginTableVersion, LoadImage, Encode, OpenVideo, CreateVideo};
+const CodecsPluginTable kTable = {kCodecsPluginTableVersion, kCodecsPluginBuild, LoadImage, Encode, OpenVideo, CreateVideo};
 
 }  // namespace
 }  // namespace omnical

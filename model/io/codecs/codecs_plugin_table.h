@@ -1,6 +1,8 @@
 // What libomnical_codecs_plugin.so hands the loader (image_codecs.cc): one table of entry
 // points, built by the same compiler and against the same OpenCV as the code calling it.
-// The version changes with the table, so an older plugin found first is skipped.
+// The version changes with the table's layout, and the build names omnical's version, the
+// compiler, OpenCV and the build tree (CMake: OMNICAL_CODECS_BUILD_ID), so a plugin of an
+// older table or of another build, found first, is skipped.
 #pragma once
 
 #include <memory>
@@ -11,16 +13,18 @@
 
 namespace omnical {
 
-constexpr int kCodecsPluginTableVersion = 1;
+constexpr int kCodecsPluginTableVersion = 2;
+constexpr char kCodecsPluginBuild[] = OMNICAL_CODECS_BUILD_ID;
 
 struct CodecsPluginTable {
-  int version;
+  int version;  // first in every version, so an older table is recognised
+  const char* build;  // kCodecsPluginBuild
   cv::Mat (*load_image)(const std::string& path, int imread_flags);
   bool (*encode_image)(const std::string& extension, const cv::Mat& image, std::vector<unsigned char>* bytes,
                        const std::vector<int>& imwrite_params);
   std::unique_ptr<VideoFrameReader> (*open_video)(const std::string& path);
   std::unique_ptr<VideoFrameWriter> (*create_video)(const std::string& path, int fourcc, double frames_per_second,
-                                                    cv::Size frame_size, bool colour);
+                                                    cv::Size frame_size_px, bool colour);
 };
 
 }  // namespace omnical

@@ -4,9 +4,12 @@
 // them was most of each process's start (~0.25 s of an `omnical` call, ~0.17 s of a test
 // program's), where projecting points or fitting detections never touches a file of
 // pixels (tests/bench/startup_cost.py). They live in a plugin, libomnical_codecs_plugin.so,
-// in <libdir>/omnical (found as image_codecs.cc says; OMNICAL_CODECS_PLUGIN names it).
-// Every function below throws InputError (naming OMNICAL_CODECS_PLUGIN and each path tried)
-// when the plugin cannot be found.
+// in <libdir>/omnical of the build tree or the install prefix. It is found beside an
+// installed program or Python package, through the RUNPATH omnical's CMake package gives
+// programs built against it, or in the configured install and build directories; the
+// environment variable OMNICAL_CODECS_PLUGIN, when set, names the one file to load.
+// The first call of any function below loads it, and throws InputError (naming
+// OMNICAL_CODECS_PLUGIN and each path tried) when no plugin of this build can be loaded.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -47,7 +50,7 @@ class VideoFrameWriter {
 std::unique_ptr<VideoFrameReader> OpenVideoFile(const std::string& path);
 // nullptr when no codec writes `fourcc` to `path` (its extension picks the container).
 std::unique_ptr<VideoFrameWriter> CreateVideoFile(const std::string& path, int fourcc, double frames_per_second,
-                                                  cv::Size frame_size, bool colour);
+                                                  cv::Size frame_size_px, bool colour);
 
 // cv::VideoWriter::fourcc: four characters as OpenCV's codec code.
 constexpr int VideoFourcc(char c1, char c2, char c3, char c4) {
