@@ -78,9 +78,18 @@ def check(root, layers):
 # OpenCV's imgcodecs and videoio are loaded on first use, by the codecs layer alone
 # (model/io/codecs/image_codecs.h): a direct call elsewhere would link them into every
 # process again. Their headers may still be included for the IMREAD_/IMWRITE_ constants.
-FILE_CODEC_CALL = re.compile(r"\bcv::(imread|imreadmulti|imwrite|imwritemulti|imencode|imdecode|haveImageReader|"
-                             r"haveImageWriter|VideoCapture|VideoWriter)\b")
+FILE_CODEC_NAMES = ("imread|imreadmulti|imreadanimation|imcount|imwrite|imwritemulti|imencode|imdecode|imdecodemulti|"
+                    "haveImageReader|haveImageWriter|VideoCapture|VideoWriter|videoio_registry")
+# Qualified (cv::imread) or, after `using namespace cv`, called bare (imread(...)).
+FILE_CODEC_CALL = re.compile(r"\bcv::(%s)\b|(?<![\w:.>])(%s)\s*\(" % (FILE_CODEC_NAMES, FILE_CODEC_NAMES))
 CODEC_USERS = ("codecs", "tests")
+# Comments and string literals, blanked before the search (their newlines kept, so line
+# numbers still match).
+COMMENT_OR_STRING = re.compile(r'//[^\n]*|/\*.*?\*/|"(?:\\.|[^"\\\n])*"|\'(?:\\.|[^\'\\\n])*\'', re.S)
+
+
+def code_only(text):
+    return COMMENT_OR_STRING.sub(lambda m: re.sub(r"[^\n]", " ", m.group(0)), text)
 
 
 def file_codecs_stay_in_their_layer(root, layers):
@@ -91,14 +100,15 @@ def file_codecs_stay_in_their_layer(root, layers):
         for folder, _, files in os.walk(os.path.join(root, directory)):
             for file in files:
                 path = os.path.relpath(os.path.join(folder, file), root)
-                if not file.endswith((".h", ".cc")) or layer_of(path, layers)[0] != name:
+                if not file.endswith((".h", ".cc", ".cpp", ".hpp")) or layer_of(path, layers)[0] != name:
                     continue
                 with open(os.path.join(root, path), errors="replace") as f:
-                    for number, line in enumerate(f, 1):
-                        match = FILE_CODEC_CALL.search(line.split("//")[0])
-                        if match:
-                            problems.append(f"{path}:{number}: layer {name} calls {match.group(0)} "
-                                            "(through model/io/codecs/image_codecs.h only)")
+                    code = code_only(f.read())
+                for number, line in enumerate(code.split("\n"), 1):
+                    match = FILE_CODEC_CALL.search(line)
+                    if match:
+                        problems.append(f"{path}:{number}: layer {name} calls {match.group(0).rstrip('( ')} "
+                                        "(through model/io/codecs/image_codecs.h only)")
     return problems
 
 
@@ -148,11 +158,14 @@ def self_test(root, layers):
         open(os.path.join(tmp, "calib", "a.h"), "w").write("#pragma once\n")
         open(os.path.join(tmp, "correction", "b.cc"), "w").write('#include "calib/a.h"\n')
         open(os.path.join(tmp, "model", "c.cc"), "w").write("#include <opencv2/core.hpp>\n")
-        open(os.path.join(tmp, "calib", "d.cc"), "w").write("// cv::imread is not called here\n"
-                                                            "cv::Mat image = cv::imread(path);\n")
+        open(os.path.join(tmp, "calib", "d.cc"), "w").write(
+            "// cv::imread is not called here, /* nor cv::imencode\n here */ \"nor cv::VideoWriter\"\n"
+            "cv::Mat image = cv::imread(path);\nusing namespace cv;\nauto bytes = imencode(\".png\", image);\n"
+            "int flag = cv::IMREAD_GRAYSCALE; reader.imread(x); cv::VideoCaptureAPIs api;\n")
         table = read_table(tmp)
         found = check(tmp, table) + file_codecs_stay_in_their_layer(tmp, table)
-        expected = ["calib/d.cc:2: layer calib calls cv::imread (through model/io/codecs/image_codecs.h only)",
+        expected = ["calib/d.cc:3: layer calib calls cv::imread (through model/io/codecs/image_codecs.h only)",
+                    "calib/d.cc:5: layer calib calls imencode (through model/io/codecs/image_codecs.h only)",
                     "correction/b.cc: layer correction may not include calib/a.h (layer calib)",
                     "model/c.cc: layer model may not use <opencv2/core.hpp> (opencv2)"]
         if sorted(found) != expected:

@@ -2,11 +2,13 @@
 # End-to-end checks of the omnical command line: results of project/unproject, and the
 # bad-input policy (exit code 2, exactly one line on stderr naming the file and field,
 # no output file left behind).
-# Usage: cli_test.sh OMNICAL_BINARY SOURCE_DIR CODECS_PLUGIN_OF_ANOTHER_BUILD
+# Usage: cli_test.sh OMNICAL_BINARY SOURCE_DIR CODECS_PLUGIN_OF_ANOTHER_BUILD CODECS_PLUGIN LIBDIR
 set -u
 omnical=$1
 source_dir=$(cd "$2" && pwd)
 other_build_plugin=$3
+codecs_plugin=$4
+libdir=$5
 sensors=$source_dir/datasets-synthetic/sensors
 source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
 
@@ -169,6 +171,18 @@ OMNICAL_CODECS_PLUGIN=$work/no-plugin.so expect_error codecs_plugin_missing \
   target --spec "$targets/aprilgrid-6x6-30mm.yaml" --out "$work/out.csv.png"
 OMNICAL_CODECS_PLUGIN=$other_build_plugin expect_error codecs_plugin_of_another_build \
   "OMNICAL_CODECS_PLUGIN: $other_build_plugin: from another build (another build of omnical; this program's: omnical " -- \
+  target --spec "$targets/aprilgrid-6x6-30mm.yaml" --out "$work/out.csv.png"
+# Without it, a prefix moved as a whole finds its own plugin (<prefix>/bin/omnical ->
+# <prefix>/<libdir>/omnical), but not one others may write (anyone can make /tmp/lib).
+moved=$work/moved-prefix
+mkdir -p "$moved/bin" "$moved/$libdir/omnical"
+cp "$omnical" "$moved/bin/omnical"
+cp "$codecs_plugin" "$moved/$libdir/omnical/"
+"$moved/bin/omnical" -q target --spec "$targets/aprilgrid-6x6-30mm.yaml" --dpi 20 --out "$work/moved.png" &&
+  [ -s "$work/moved.png" ] && pass || fail "a moved prefix's omnical did not write a PNG through its own plugin"
+chmod o+w "$moved/$libdir/omnical"
+omnical=$moved/bin/omnical expect_error codecs_plugin_others_may_write \
+  "$moved/$libdir/omnical/libomnical_codecs_plugin.so (not loaded: others may write $moved/$libdir/omnical)" -- \
   target --spec "$targets/aprilgrid-6x6-30mm.yaml" --out "$work/out.csv.png"
 
 cat >"$work/scene.yaml" <<YAML

@@ -1,8 +1,9 @@
 // What libomnical_codecs_plugin.so hands the loader (image_codecs.cc): one table of entry
 // points, built by the same compiler and against the same OpenCV as the code calling it.
 // The version changes with the table's layout, and the build names omnical's version, the
-// compiler, OpenCV and the build tree (CMake: OMNICAL_CODECS_BUILD_ID), so a plugin of an
-// older table or of another build, found first, is skipped.
+// compiler, OpenCV and the build tree (CMake: OMNICAL_CODECS_BUILD_ID), so a plugin of
+// another table or another build, found first, is skipped. The build id sits in the
+// plugin's file after kCodecsPluginMarker, where the loader reads it before loading.
 #pragma once
 
 #include <memory>
@@ -14,7 +15,8 @@
 namespace omnical {
 
 constexpr int kCodecsPluginTableVersion = 2;
-constexpr char kCodecsPluginBuild[] = OMNICAL_CODECS_BUILD_ID;
+constexpr char kCodecsPluginMarker[] = "omnical codecs plugin build: ";
+constexpr char kCodecsPluginBuild[] = "omnical codecs plugin build: " OMNICAL_CODECS_BUILD_ID;
 
 struct CodecsPluginTable {
   int version;  // first in every version, so an older table is recognised

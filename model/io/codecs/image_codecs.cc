@@ -1,11 +1,16 @@
 #include "model/io/codecs/image_codecs.h"
 
 #include <dlfcn.h>
+#include <link.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <mutex>
 
 #include "model/input_error.h"
@@ -24,8 +29,12 @@ constexpr char kPluginFile[] = "libomnical_codecs_plugin.so";
 // "lib/python3/dist-packages/omnical"), or empty when it does not end so.
 std::filesystem::path PrefixEndingIn(const std::filesystem::path& directory, const std::filesystem::path& suffix) {
   if (suffix.empty() || suffix.is_absolute()) return {};
-  std::filesystem::path prefix = directory;
-  std::vector<std::filesystem::path> tail(suffix.begin(), suffix.end());
+  std::vector<std::filesystem::path> tail;
+  for (const std::filesystem::path& part : suffix.lexically_normal())
+    if (!part.empty() && part != ".") tail.push_back(part);
+  if (tail.empty() || std::find(tail.begin(), tail.end(), "..") != tail.end()) return {};
+  std::filesystem::path prefix = directory.lexically_normal();
+  if (prefix.filename().empty()) prefix = prefix.parent_path();  // a trailing separator
   for (auto part = tail.rbegin(); part != tail.rend(); ++part) {
     if (prefix.filename() != *part || !prefix.has_relative_path()) return {};
     prefix = prefix.parent_path();
@@ -33,70 +42,135 @@ std::filesystem::path PrefixEndingIn(const std::filesystem::path& directory, con
   return prefix;
 }
 
-// Where the plugin may be when OMNICAL_CODECS_PLUGIN is not set, first found first. For the
-// module holding this code (the Python extension, or the
-// program) and then the program itself: when it sits where `cmake --install` puts it
-// (<prefix>/bin, or the Python package's directory), <prefix>/<libdir>/omnical, so a
-// relocated install finds its own plugin; then the loader's search by name (LD_LIBRARY_PATH,
-// and the RUNPATH omnical's CMake package gives programs linking an installed omnical); then
-// the configured install directory, then the build tree this code was built in. Only these:
-// no directory above an arbitrary program's (such as /tmp/lib) is ever tried.
-std::vector<std::string> PluginCandidates() {
+bool IsUnder(const std::filesystem::path& path, const std::filesystem::path& directory) {
+  const std::filesystem::path relative = path.lexically_relative(directory);
+  return !relative.empty() && *relative.begin() != "..";
+}
+
+// The directories omnical's code runs from: the module holding this code when it is not
+// the main program (the Python extension), then the main program's. dladdr names the main
+// program as argv[0], which its caller chooses, so the link map tells it apart (an empty
+// name) and /proc/self/exe, the file really run, stands for it.
+std::vector<std::filesystem::path> CodeDirectories() {
   std::vector<std::filesystem::path> directories;
-  // dladdr names the main program only as argv[0], perhaps relative to a directory since
-  // left: a relative answer is not used, /proc/self/exe covers the program.
   Dl_info info{};
-  if (::dladdr(reinterpret_cast<void*>(&PluginCandidates), &info) != 0 && info.dli_fname != nullptr &&
-      info.dli_fname[0] == '/')
-    directories.push_back(std::filesystem::path(info.dli_fname).parent_path());
+  link_map* module = nullptr;
+  if (::dladdr1(reinterpret_cast<void*>(&CodeDirectories), &info, reinterpret_cast<void**>(&module),
+                RTLD_DL_LINKMAP) != 0 &&
+      module != nullptr && module->l_name != nullptr && module->l_name[0] == '/') {
+    std::error_code error;
+    const std::filesystem::path file = std::filesystem::canonical(module->l_name, error);
+    if (!error) directories.push_back(file.parent_path());
+  }
   std::error_code error;
   const std::filesystem::path program = std::filesystem::read_symlink("/proc/self/exe", error);
   if (!error) directories.push_back(program.parent_path());
+  return directories;
+}
+
+// Where the plugin may be when OMNICAL_CODECS_PLUGIN is not set, first found first. For
+// each code directory (above): the build tree's plugin when the code lies in the build
+// tree it was built in (tests, the CLI and the Python package before install); <prefix>/
+// <libdir>/omnical when it sits where `cmake --install` puts it (<prefix>/bin, or the
+// Python package's directory), so a moved prefix finds its own plugin. Then the loader's
+// search by name (LD_LIBRARY_PATH, and the RUNPATH omnical's CMake package gives programs
+// linking an installed omnical), then the configured install directory.
+std::vector<std::string> PluginCandidates() {
   std::vector<std::string> candidates;
-  for (const std::filesystem::path& directory : directories) {
+  std::error_code error;
+  const std::filesystem::path build_tree = std::filesystem::weakly_canonical(OMNICAL_CODECS_BUILD_TREE, error);
+  for (const std::filesystem::path& directory : CodeDirectories()) {
+    if (!error && IsUnder(directory, build_tree)) candidates.push_back(OMNICAL_CODECS_BUILD_DIR "/" + std::string(kPluginFile));
     for (const char* layout : {OMNICAL_CODECS_BINDIR, OMNICAL_CODECS_PYTHON_PACKAGE_DIR}) {
-      const std::filesystem::path prefix = PrefixEndingIn(directory.lexically_normal(), layout);
+      const std::filesystem::path prefix = PrefixEndingIn(directory, layout);
       if (!prefix.empty())
         candidates.push_back((prefix / OMNICAL_CODECS_LIBDIR / "omnical" / kPluginFile).lexically_normal().string());
     }
   }
   candidates.push_back(kPluginFile);
   candidates.push_back(OMNICAL_CODECS_INSTALL_DIR "/" + std::string(kPluginFile));
-  candidates.push_back(OMNICAL_CODECS_BUILD_DIR "/" + std::string(kPluginFile));
   std::vector<std::string> unique;  // each tried once, in order
   for (const std::string& candidate : candidates)
     if (std::find(unique.begin(), unique.end(), candidate) == unique.end()) unique.push_back(candidate);
   return unique;
 }
 
-// The table of the plugin at `candidate`, or null with `why` saying what was wrong (empty
-// when there is no such file); a plugin that is not used is closed again.
-const CodecsPluginTable* OpenPlugin(const std::string& candidate, std::string* why) {
+// Whether a plugin found by searching may be loaded: the file and its directory belong to
+// root, to this user or to the owner of the code loading it (whoever installed omnical),
+// and others cannot write them. A directory anyone can create (such as /tmp/lib) then
+// offers nothing to load.
+std::string UntrustedWhy(const std::string& path) {
+  std::vector<uid_t> trusted = {0, ::geteuid()};
+  struct stat status {};
+  for (const std::filesystem::path& directory : CodeDirectories())
+    if (::stat(directory.c_str(), &status) == 0) trusted.push_back(status.st_uid);
+  for (const std::string& checked : {path, std::filesystem::path(path).parent_path().string()}) {
+    if (::stat(checked.c_str(), &status) != 0) return "cannot stat " + checked;
+    if (std::find(trusted.begin(), trusted.end(), status.st_uid) == trusted.end())
+      return "not loaded: " + checked + " belongs to uid " + std::to_string(status.st_uid);
+    if (status.st_mode & S_IWOTH) return "not loaded: others may write " + checked;
+  }
+  return {};
+}
+
+// The build id the plugin file at `path` carries (kCodecsPluginBuild, after its marker), or
+// empty without one. Read from the file, before it is loaded: loading a plugin runs the
+// initialisers of the ~240 libraries it brings, which unloading it again does not undo.
+std::string BuildIdInFile(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const size_t at = bytes.find(kCodecsPluginMarker);
+  if (at == std::string::npos) return {};
+  return bytes.c_str() + at;  // up to its terminating NUL
+}
+
+// The table of the plugin at `candidate` (a path, or the bare name for the loader's own
+// search), or null with `why` saying what was wrong: empty when there is no such file.
+const CodecsPluginTable* OpenPlugin(const std::string& candidate, bool searched, std::string* why) {
+  const auto without_marker = [](const std::string& id) { return id.substr(std::strlen(kCodecsPluginMarker)); };
+  if (candidate.find('/') != std::string::npos) {
+    struct stat status {};
+    if (::stat(candidate.c_str(), &status) != 0) return nullptr;  // not there
+    if (searched && !(*why = UntrustedWhy(candidate)).empty()) return nullptr;
+    const std::string build = BuildIdInFile(candidate);
+    if (build.empty()) {
+      *why = "not an omnical codecs plugin";
+      return nullptr;
+    }
+    if (build != kCodecsPluginBuild) {
+      // The table passes std::string and cv::Mat across: only a plugin of this very build
+      // is known to agree with it.
+      *why = "from another build (" + without_marker(build) + "; this program's: " + without_marker(kCodecsPluginBuild) + ")";
+      return nullptr;
+    }
+  }
   void* handle = ::dlopen(candidate.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (handle == nullptr) {
     const char* loader_error = ::dlerror();
-    // "No such file" is the ordinary miss; anything else (a plugin that exists but does not
-    // load) is worth the loader's own words.
-    const bool missing = loader_error == nullptr || std::strstr(loader_error, "No such file") != nullptr;
-    *why = missing ? "" : loader_error;
-    if (why->rfind(candidate + ": ", 0) == 0) why->erase(0, candidate.size() + 2);  // named already
+    std::string text = loader_error != nullptr ? loader_error : "cannot be loaded";
+    if (text.rfind(candidate + ": ", 0) == 0) {
+      text.erase(0, candidate.size() + 2);  // named already
+      if (text.find("No such file") != std::string::npos) text.clear();  // the file itself: not there
+    }
+    *why = text;  // otherwise a library it needs, or a file that is no plugin
     return nullptr;
   }
+  // Found by the loader's search, the file was not read first: the table says the same.
+  // A refused plugin stays loaded: closing it again is not safe once its libraries ran.
   using Entry = const CodecsPluginTable* (*)();
   const auto entry = reinterpret_cast<Entry>(::dlsym(handle, "omnical_codecs_plugin_table"));
   const CodecsPluginTable* table = entry != nullptr ? entry() : nullptr;
   if (table == nullptr) {
     *why = "not an omnical codecs plugin";
-  } else if (table->version != kCodecsPluginTableVersion || std::strcmp(table->build, kCodecsPluginBuild) != 0) {
-    // The table's layout and the std::string, cv::Mat it passes are only known to agree
-    // with a plugin of this very build.
-    *why = std::string("from another build (") + (table->version == kCodecsPluginTableVersion ? table->build : "older") +
-           "; this program's: " + kCodecsPluginBuild + ")";
-    table = nullptr;
+  } else if (table->version != kCodecsPluginTableVersion) {
+    *why = "from another build (entry table version " + std::to_string(table->version) + ", this program's " +
+           std::to_string(kCodecsPluginTableVersion) + ")";
+  } else if (std::strcmp(table->build, kCodecsPluginBuild) != 0) {
+    *why = "from another build (" + without_marker(table->build) + "; this program's: " +
+           without_marker(kCodecsPluginBuild) + ")";
   } else {
-    return table;  // never closed: the codecs stay for the process's life, as linked ones would
+    return table;  // kept for the process's life, as linked codecs would be
   }
-  ::dlclose(handle);
   return nullptr;
 }
 
@@ -107,9 +181,11 @@ const CodecsPluginTable& Plugin() {
   std::call_once(once, [] {
     // A missing or wrong file of the installation is bad input named by the variable that
     // points at it: an InputError, so the CLI exits 2 and Python raises omnical.InputError.
-    if (const char* named = std::getenv("OMNICAL_CODECS_PLUGIN"); named && *named) {
+    if (const char* named = ::secure_getenv("OMNICAL_CODECS_PLUGIN"); named && *named) {
+      // A file, even without a directory: not a name for the loader's search.
+      const std::string path = std::strchr(named, '/') != nullptr ? named : std::string("./") + named;
       std::string why;
-      table = OpenPlugin(named, &why);
+      table = OpenPlugin(path, false, &why);
       if (table == nullptr)
         failure = InputMessage("OMNICAL_CODECS_PLUGIN", named,
                                (why.empty() ? "no such file" : why) + "; it must name " + kPluginFile +
@@ -119,7 +195,7 @@ const CodecsPluginTable& Plugin() {
     std::string tried;
     for (const std::string& candidate : PluginCandidates()) {
       std::string why;
-      table = OpenPlugin(candidate, &why);
+      table = OpenPlugin(candidate, true, &why);
       if (table != nullptr) return;
       tried += (tried.empty() ? "" : ", ") + candidate + (why.empty() ? "" : " (" + why + ")");
     }

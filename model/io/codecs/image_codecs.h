@@ -4,12 +4,13 @@
 // them was most of each process's start (~0.25 s of an `omnical` call, ~0.17 s of a test
 // program's), where projecting points or fitting detections never touches a file of
 // pixels (tests/bench/startup_cost.py). They live in a plugin, libomnical_codecs_plugin.so,
-// in <libdir>/omnical of the build tree or the install prefix. It is found beside an
-// installed program or Python package, through the RUNPATH omnical's CMake package gives
-// programs built against it, or in the configured install and build directories; the
-// environment variable OMNICAL_CODECS_PLUGIN, when set, names the one file to load.
-// The first call of any function below loads it, and throws InputError (naming
-// OMNICAL_CODECS_PLUGIN and each path tried) when no plugin of this build can be loaded.
+// in <libdir>/omnical of the build tree or the install prefix, and are found as
+// docs/library-api.md says (from the build tree for programs in it, beside an installed
+// program or Python package, through the RUNPATH omnical's CMake package gives programs built against it, or
+// in the configured install directory); the environment variable OMNICAL_CODECS_PLUGIN,
+// when set, names the one file to load. The first call of any function below loads it, and
+// throws InputError (naming OMNICAL_CODECS_PLUGIN and each path tried) when no plugin of
+// this build can be loaded; after that they fail only as their OpenCV counterparts do.
 #pragma once
 
 #include <opencv2/core.hpp>
