@@ -178,6 +178,7 @@ moved=$work/moved-prefix
 mkdir -p "$moved/bin" "$moved/$libdir/omnical"
 cp "$omnical" "$moved/bin/omnical"
 cp "$codecs_plugin" "$moved/$libdir/omnical/"
+chmod 755 "$moved/$libdir/omnical" "$moved/$libdir/omnical/libomnical_codecs_plugin.so"  # whatever the umask
 "$moved/bin/omnical" -q target --spec "$targets/aprilgrid-6x6-30mm.yaml" --dpi 20 --out "$work/moved.png" &&
   [ -s "$work/moved.png" ] && pass || fail "a moved prefix's omnical did not write a PNG through its own plugin"
 chmod o+w "$moved/$libdir/omnical"

@@ -116,12 +116,19 @@ std::string UntrustedWhy(const std::string& path) {
 // The build id the plugin file at `path` carries (kCodecsPluginBuild, after its marker), or
 // empty without one. Read from the file, before it is loaded: loading a plugin runs the
 // initialisers of the ~240 libraries it brings, which unloading it again does not undo.
+// Should the compiler keep the marker on its own as well, this build's id is still found
+// among the others.
 std::string BuildIdInFile(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  const size_t at = bytes.find(kCodecsPluginMarker);
-  if (at == std::string::npos) return {};
-  return bytes.c_str() + at;  // up to its terminating NUL
+  std::string found;
+  for (size_t at = bytes.find(kCodecsPluginMarker); at != std::string::npos;
+       at = bytes.find(kCodecsPluginMarker, at + 1)) {
+    const std::string id = bytes.c_str() + at;  // up to its terminating NUL
+    if (id == kCodecsPluginBuild) return id;
+    if (id.size() > found.size()) found = id;
+  }
+  return found;
 }
 
 // The table of the plugin at `candidate` (a path, or the bare name for the loader's own
@@ -132,7 +139,8 @@ const CodecsPluginTable* OpenPlugin(const std::string& candidate, bool searched,
     struct stat status {};
     if (::stat(candidate.c_str(), &status) != 0) return nullptr;  // not there
     if (searched && !(*why = UntrustedWhy(candidate)).empty()) return nullptr;
-    const std::string build = BuildIdInFile(candidate);
+    // The plugin is ~20 KB (a debug build's under a MB): a file far larger is not read.
+    const std::string build = status.st_size < (64 << 20) ? BuildIdInFile(candidate) : std::string();
     if (build.empty()) {
       *why = "not an omnical codecs plugin";
       return nullptr;
