@@ -75,11 +75,11 @@ std::vector<std::filesystem::path> CodeDirectories() {
 // Python package's directory), so a moved prefix finds its own plugin. Then the loader's
 // search by name (LD_LIBRARY_PATH, and the RUNPATH omnical's CMake package gives programs
 // linking an installed omnical), then the configured install directory.
-std::vector<std::string> PluginCandidates() {
+std::vector<std::string> PluginCandidates(const std::vector<std::filesystem::path>& code_directories) {
   std::vector<std::string> candidates;
   std::error_code error;
   const std::filesystem::path build_tree = std::filesystem::weakly_canonical(OMNICAL_CODECS_BUILD_TREE, error);
-  for (const std::filesystem::path& directory : CodeDirectories()) {
+  for (const std::filesystem::path& directory : code_directories) {
     if (!error && IsUnder(directory, build_tree)) candidates.push_back(OMNICAL_CODECS_BUILD_DIR "/" + std::string(kPluginFile));
     for (const char* layout : {OMNICAL_CODECS_BINDIR, OMNICAL_CODECS_PYTHON_PACKAGE_DIR}) {
       const std::filesystem::path prefix = PrefixEndingIn(directory, layout);
@@ -95,15 +95,21 @@ std::vector<std::string> PluginCandidates() {
   return unique;
 }
 
-// Whether a plugin found by searching may be loaded: the file and its directory belong to
-// root, to this user or to the owner of the code loading it (whoever installed omnical),
-// and others cannot write them. A directory anyone can create (such as /tmp/lib) then
-// offers nothing to load.
-std::string UntrustedWhy(const std::string& path) {
+// Who may own a plugin found by searching: root, this user and the owners of the code
+// directories (whoever installed omnical).
+std::vector<uid_t> TrustedOwners(const std::vector<std::filesystem::path>& code_directories) {
   std::vector<uid_t> trusted = {0, ::geteuid()};
   struct stat status {};
-  for (const std::filesystem::path& directory : CodeDirectories())
+  for (const std::filesystem::path& directory : code_directories)
     if (::stat(directory.c_str(), &status) == 0) trusted.push_back(status.st_uid);
+  return trusted;
+}
+
+// Whether a plugin found by searching may be loaded: the file and its directory belong to
+// a trusted owner and others cannot write them. A directory anyone can create (such as
+// /tmp/lib) then offers nothing to load.
+std::string UntrustedWhy(const std::string& path, const std::vector<uid_t>& trusted) {
+  struct stat status {};
   for (const std::string& checked : {path, std::filesystem::path(path).parent_path().string()}) {
     if (::stat(checked.c_str(), &status) != 0) return "cannot stat " + checked;
     if (std::find(trusted.begin(), trusted.end(), status.st_uid) == trusted.end())
@@ -131,14 +137,22 @@ std::string BuildIdInFile(const std::string& path) {
   return found;
 }
 
+// Why a plugin of build `build` (its id with the marker) is refused: the table passes
+// std::string and cv::Mat across, and only a plugin of this very build is known to agree.
+std::string AnotherBuild(const std::string& build) {
+  const size_t marker = std::strlen(kCodecsPluginMarker);
+  return "from another build (" + build.substr(std::min(marker, build.size())) +
+         "; this program's: " + std::string(kCodecsPluginBuild + marker) + ")";
+}
+
 // The table of the plugin at `candidate` (a path, or the bare name for the loader's own
 // search), or null with `why` saying what was wrong: empty when there is no such file.
-const CodecsPluginTable* OpenPlugin(const std::string& candidate, bool searched, std::string* why) {
-  const auto without_marker = [](const std::string& id) { return id.substr(std::strlen(kCodecsPluginMarker)); };
+// `trusted`: the owners a plugin found by searching may have; null for a file the user named.
+const CodecsPluginTable* OpenPlugin(const std::string& candidate, const std::vector<uid_t>* trusted, std::string* why) {
   if (candidate.find('/') != std::string::npos) {
     struct stat status {};
     if (::stat(candidate.c_str(), &status) != 0) return nullptr;  // not there
-    if (searched && !(*why = UntrustedWhy(candidate)).empty()) return nullptr;
+    if (trusted != nullptr && !(*why = UntrustedWhy(candidate, *trusted)).empty()) return nullptr;
     // The plugin is ~20 KB (a debug build's under a MB): a file far larger is not read.
     const std::string build = status.st_size < (64 << 20) ? BuildIdInFile(candidate) : std::string();
     if (build.empty()) {
@@ -146,9 +160,7 @@ const CodecsPluginTable* OpenPlugin(const std::string& candidate, bool searched,
       return nullptr;
     }
     if (build != kCodecsPluginBuild) {
-      // The table passes std::string and cv::Mat across: only a plugin of this very build
-      // is known to agree with it.
-      *why = "from another build (" + without_marker(build) + "; this program's: " + without_marker(kCodecsPluginBuild) + ")";
+      *why = AnotherBuild(build);
       return nullptr;
     }
   }
@@ -174,8 +186,7 @@ const CodecsPluginTable* OpenPlugin(const std::string& candidate, bool searched,
     *why = "from another build (entry table version " + std::to_string(table->version) + ", this program's " +
            std::to_string(kCodecsPluginTableVersion) + ")";
   } else if (std::strcmp(table->build, kCodecsPluginBuild) != 0) {
-    *why = "from another build (" + without_marker(table->build) + "; this program's: " +
-           without_marker(kCodecsPluginBuild) + ")";
+    *why = AnotherBuild(table->build);
   } else {
     return table;  // kept for the process's life, as linked codecs would be
   }
@@ -193,17 +204,19 @@ const CodecsPluginTable& Plugin() {
       // A file, even without a directory: not a name for the loader's search.
       const std::string path = std::strchr(named, '/') != nullptr ? named : std::string("./") + named;
       std::string why;
-      table = OpenPlugin(path, false, &why);
+      table = OpenPlugin(path, nullptr, &why);
       if (table == nullptr)
         failure = InputMessage("OMNICAL_CODECS_PLUGIN", named,
                                (why.empty() ? "no such file" : why) + "; it must name " + kPluginFile +
                                    " (omnical's image and video file support) of this build, or be unset");
       return;
     }
+    const std::vector<std::filesystem::path> code_directories = CodeDirectories();
+    const std::vector<uid_t> trusted = TrustedOwners(code_directories);
     std::string tried;
-    for (const std::string& candidate : PluginCandidates()) {
+    for (const std::string& candidate : PluginCandidates(code_directories)) {
       std::string why;
-      table = OpenPlugin(candidate, true, &why);
+      table = OpenPlugin(candidate, &trusted, &why);
       if (table != nullptr) return;
       tried += (tried.empty() ? "" : ", ") + candidate + (why.empty() ? "" : " (" + why + ")");
     }
