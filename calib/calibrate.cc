@@ -14,7 +14,9 @@
 #include "calib/checkerboard_completion.h"
 #include "calib/cross_validation.h"
 #include "calib/fit_covariance.h"
+#include "calib/fold_scores.h"
 #include "calib/image_file.h"
+#include "calib/lens_choice.h"
 #include "calib/rim_circle.h"
 #include "model/input_error.h"
 #include "model/model_registry.h"
@@ -336,6 +338,12 @@ std::map<std::string, CalibrationRecord::Spread> LeaveOneOut(const Sensor& start
   return spread;
 }
 
+bool HoldsTangential(const std::set<std::string>& fixed) {
+  RefineOptions held;
+  held.Hold(fixed);  // an unknown name is the fit's error to report
+  return !held.tangential;
+}
+
 }  // namespace
 
 std::string CalibrationOptions::Check() const {
@@ -347,11 +355,8 @@ std::string CalibrationOptions::Check() const {
     return "lens: the rim circle starts an orthographic or a pinhole lens, or 'auto' (got '" + lens + "')";
   if (!tangential.empty() && tangential != kTangentialOff && tangential != kTangentialOn && tangential != kChooseTangential)
     return "tangential: off, on or auto (got '" + tangential + "')";
-  if (tangential == kTangentialOn || tangential == kChooseTangential) {
-    RefineOptions held;
-    held.Hold(fixed);  // an unknown name is the fit's error to report
-    if (!held.tangential) return "tangential/fixed: tangential " + tangential + " fits p1, p2, which fixed holds";
-  }
+  if ((tangential == kTangentialOn || tangential == kChooseTangential) && HoldsTangential(fixed))
+    return "tangential/fixed: tangential " + tangential + " fits p1, p2, which fixed holds";
   if (!(loss_px >= 0.0 && std::isfinite(loss_px))) return "loss_px: must be >= 0 and finite";
   if (max_iterations < 1) return "max_iterations: must be >= 1";
   // Pass 2 re-detects through the first fit; an aprilgrid's later passes through the last.
@@ -408,11 +413,13 @@ CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const
   CalibrationOptions fold_options = full_options;
   fold_options.cross_validate = false;  // each fold answers one question: how well it predicts its views
   fold_options.leave_one_out = false;
-  // The lens the full set chose (choosing again would be 10 fits more per fold, and a
-  // fold could judge another lens than the calibration written).
-  if (const auto& lens = result.record.lens_choice) fold_options.lens = lens->chosen;
+  // The lens the full set used, chosen or not (choosing again would be 10 fits more per
+  // fold, and a fold could judge another lens than the calibration written).
+  if (!input.guess) fold_options.lens = result.sensor.lens_name();
   if (const auto& tangential = result.record.tangential_choice)  // the same for the tangential terms
     fold_options.tangential = tangential->chosen == kTangentialCandidates[1] ? kTangentialOn : kTangentialOff;
+  else if (fold_options.tangential.empty())
+    fold_options.tangential = kTangentialOff;  // held: no choice was made
   if (fold_options.lens == "orthographic") fold_options.tangential = kTangentialOff;  // which it has none of
   std::vector<CalibrationWarning> warnings;  // the folds' own, added to the full set's below
   HeldOutFolds folds;
@@ -464,12 +471,19 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   if (input.guess && !options.lens.empty())
     throw InputError(InputMessage(input.guess_name, "lens", "the guess has its lens (" + std::string(input.guess->lens_name()) +
                                                                 "): lens chooses the rim circle's start, without a guess"));
-  // p1, p2 are a pinhole's: refused where the lens is known to be orthographic (with
-  // lens auto an orthographic choice leaves them out).
-  const std::string known_lens = input.guess                             ? input.guess->lens_name()
-                                 : options.lens.empty()                  ? "orthographic"
-                                 : options.lens == kChooseLens           ? ""
-                                                                         : options.lens;
+  // Without a guess the lens, and a pinhole's p1, p2, are chosen by held-out folds unless
+  // asked for: the rim circle cannot tell a telecentric lens from a perspective camera, and
+  // through the wrong one a set's own corners still fit while new views do not (the
+  // bundled mixed renders: held out 2.61 px through the orthographic, 0.30 through the
+  // pinhole; docs/calibrate.md). A set too small for folds keeps the orthographic lens,
+  // p1, p2 held.
+  const bool lens_by_default = !input.guess && options.lens.empty();
+  const bool tangential_by_default = !input.guess && options.tangential.empty();
+  // p1, p2 are a pinhole's: refused where the lens is known to be orthographic (where the
+  // lens is chosen, an orthographic choice leaves them out).
+  const std::string known_lens = input.guess ? input.guess->lens_name()
+                                 : options.lens.empty() || options.lens == kChooseLens ? ""
+                                                                                       : options.lens;
   if (!options.tangential.empty() && options.tangential != kTangentialOff && known_lens == "orthographic") {
     const std::string why = "the orthographic lens has no tangential distortion (p1, p2 are a pinhole's)";
     throw InputError(input.guess ? InputMessage(input.guess_name, "tangential", why)
@@ -578,7 +592,8 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
                      " views (need >= 3 per half, >= 6 usable views in all)");
   // Without a guess, the lens by held-out folds on the first pass's corners, before the
   // corners are refined through a fit with it (calib/lens_choice.h).
-  if (options.lens == kChooseLens) {
+  const bool foldable = static_cast<int>(views.detections.images.size()) >= kMinViewsForFolds;
+  if (options.lens == kChooseLens || (lens_by_default && foldable)) {
     std::vector<std::optional<FoldCandidate>> candidates;
     for (const std::string& lens : kLensCandidates) {
       if (lens == guess.lens_name()) {
@@ -618,7 +633,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
       warnings.push_back({WarningCode::kLensNotChosen, "lens",
                           "neither lens could be fitted to every held-out fold of the views (a view where no other "
                           "reaches?); the " + choice.chosen + " lens is kept"});
-    if (!options.tangential.empty() && options.tangential != kTangentialOff && choice.chosen == "orthographic")
+    if (!tangential_by_default && options.tangential != kTangentialOff && choice.chosen == "orthographic")
       warnings.push_back({WarningCode::kTangentialNotFitted, "tangential",
                           "tangential " + options.tangential + ": the orthographic lens was chosen, which has no "
                           "tangential distortion; p1, p2 are not fitted"});
@@ -626,7 +641,9 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   // A pinhole's tangential terms by held-out folds, from the start the lens choice left
   // (calib/tangential_choice.h). Held, that start is the lens choice's pinhole candidate:
   // its score is reused (5 fits fewer).
-  if (options.tangential == kChooseTangential && std::string(guess.lens_name()) == "pinhole") {
+  const bool choose_tangential =
+      options.tangential == kChooseTangential || (tangential_by_default && foldable && !HoldsTangential(options.fixed));
+  if (choose_tangential && std::string(guess.lens_name()) == "pinhole") {
     FitOptions fitted = fit_options;
     fitted.refine.tangential = true;
     std::optional<KnownScore> held_score;

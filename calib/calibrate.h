@@ -46,20 +46,24 @@ struct CalibrationInput {
 struct CalibrationOptions {
   std::string profile;  // mirror family to fit ("": the guess's; polynomial without a guess)
   double rim_field_deg = kDefaultRimFieldDeg;
-  // Without a guess, the lens the rim circle starts (calib/initial_sensor.h): "" or
+  // Without a guess, the lens the rim circle starts (calib/initial_sensor.h):
   // "orthographic" (a telecentric lens), "pinhole" (a perspective camera in front of the
   // mirror; with a free-form mirror its distance m and the mirror's decenter are held,
   // the gauges the free shape leaves: m trades with the focal length like a dolly zoom,
   // decenter with the principal point and tilt; k1, k2 are held as for any free-form
   // mirror), or kChooseLens: the one whose fits predict held-out folds of the views better
-  // (calib/lens_choice.h), the orthographic unless the pinhole does by more than 1 %. The
-  // folds of holdout_folds keep the lens chosen.
+  // (calib/lens_choice.h), the orthographic unless the pinhole does by more than 1 %.
+  // "" (the default): kChooseLens where the usable views allow folds
+  // (kMinViewsForFolds), else the orthographic. The folds of holdout_folds keep the lens
+  // the full set used. With a guess: "" (the guess's lens).
   std::string lens;
-  // A pinhole's tangential distortion p1, p2 (calib/tangential_choice.h): "" or "off" held
-  // at the start's values, "on" fitted, or kChooseTangential: fitted where that predicts
+  // A pinhole's tangential distortion p1, p2 (calib/tangential_choice.h): "off" held at
+  // the start's values, "on" fitted, or kChooseTangential: fitted where that predicts
   // held-out folds of the views better by more than 1 %. Refused with an orthographic lens;
-  // with lens auto, applied only if the pinhole is chosen. The folds of holdout_folds keep
-  // the choice.
+  // where the lens is chosen, applied only if the pinhole is. "" (the default): without a
+  // guess kChooseTangential where the views allow folds and `fixed` does not hold p1, p2
+  // (said in no warning where the orthographic lens is chosen), else "off". The folds of
+  // holdout_folds keep the choice.
   std::string tangential;
   std::set<std::string> fixed;  // blocks held, by RefineOptions::Hold's names (calib/fit_options.h)
   double loss_px = 1.0;

@@ -13,10 +13,9 @@ FoldScores ScoreByHeldOutFolds(const std::vector<FoldCandidate>& candidates, con
                                const DetectionSet& views, int threads, const std::string& stage,
                                const std::string& field, const ProgressCallback& progress) {
   const int count = static_cast<int>(views.images.size());
-  if (count < 4)
-    throw InputError(field +
-                     ": choosing by held-out folds needs >= 4 usable views (held-out folds leave >= 3 to fit); " +
-                     std::to_string(count) + " given");
+  if (count < kMinViewsForFolds)
+    throw InputError(field + ": choosing by held-out folds needs >= " + std::to_string(kMinViewsForFolds) +
+                     " usable views (held-out folds leave >= 3 to fit); " + std::to_string(count) + " given");
   FoldScores result;
   result.folds = std::min(5, count);
   const int folds = result.folds, jobs = static_cast<int>(candidates.size()) * folds;

@@ -33,11 +33,14 @@ struct FoldScores {
   int folds = 0;
 };
 
+// The fewest usable views held-out folds can score: each fold leaves >= 3 to fit.
+constexpr int kMinViewsForFolds = 4;
+
 // Five folds where the views allow (each training set keeps 4/5 of them, close to the
 // full fit the choice is for). The candidates' fold fits share `threads`, one fit per
 // thread (a fit's result is the same for any thread count, so the scores are too); the
 // last candidates' first (list the slowest last). Progress as stage `stage`. Throws
-// InputError "field: ..." with fewer than 4 views.
+// InputError "field: ..." with fewer than kMinViewsForFolds views.
 FoldScores ScoreByHeldOutFolds(const std::vector<FoldCandidate>& candidates, const CalibrationTarget& target,
                                const DetectionSet& views, int threads, const std::string& stage,
                                const std::string& field, const ProgressCallback& progress);

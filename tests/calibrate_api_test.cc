@@ -366,6 +366,48 @@ TEST(CalibrateApi, ARimCircleNotTheFitsRimIsReported) {
   EXPECT_EQ(reported, 1);
 }
 
+// Without a guess the lens and a pinhole's p1, p2 are chosen by held-out folds unless
+// asked for (CalibrationOptions::lens and tangential, ""): the choice is recorded, the
+// sensor has the lens chosen, p1, p2 are scored only through a chosen pinhole, and the
+// default says nothing where they do not apply. With fewer views than folds need, the
+// default keeps the orthographic lens quietly, where an explicit "auto" is refused.
+TEST(CalibrateApi, WithoutAGuessTheLensIsChosenWhereTheViewsAllowFolds) {
+  CalibrationInput input = InputFromTruth();
+  input.guess.reset();
+  input.guess_name.clear();
+  CalibrationOptions options;
+  options.threads = 2;
+  const CalibrationResult chosen = Calibrate(input, options);
+  ASSERT_TRUE(chosen.record.lens_choice.has_value());
+  const NamedChoice& lens = *chosen.record.lens_choice;
+  EXPECT_EQ(lens.candidates, kLensCandidates);
+  EXPECT_EQ(lens.folds, 5);
+  EXPECT_TRUE(lens.AnyScored());
+  EXPECT_EQ(lens.chosen, chosen.sensor.lens_name());
+  EXPECT_NE(chosen.record.start.find(lens.chosen + " lens (chosen by held-out folds)"), std::string::npos)
+      << chosen.record.start;
+  EXPECT_EQ(chosen.record.tangential_choice.has_value(), lens.chosen == "pinhole");
+  for (const CalibrationWarning& w : chosen.warnings) {
+    EXPECT_NE(w.code, WarningCode::kTangentialNotFitted) << w.text;
+    EXPECT_NE(w.code, WarningCode::kLensNotChosen) << w.text;
+  }
+
+  input.detections->images.resize(3);
+  const CalibrationResult few = Calibrate(input, options);
+  EXPECT_FALSE(few.record.lens_choice.has_value());
+  EXPECT_FALSE(few.record.tangential_choice.has_value());
+  EXPECT_STREQ(few.sensor.lens_name(), "orthographic");
+  EXPECT_EQ(few.record.start, "rim circle, polynomial mirror, orthographic lens");
+  options.lens = kChooseLens;
+  try {
+    Calibrate(input, options);
+    ADD_FAILURE() << "lens auto with 3 views calibrated";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("lens: choosing by held-out folds needs >= 4 usable views"), std::string::npos)
+        << e.what();
+  }
+}
+
 // Held-out folds from images (CalibrationOptions::holdout_folds) reuse the full set's
 // first detection pass instead of detecting every image again per fold (on the real dev
 // set the calibration with 5 folds went from 54 to 19 s of CPU, its results unchanged).

@@ -90,7 +90,7 @@ Command CalibrateCommand() {
             sub.add_option("--detections", options->detections_path, "Detections (JSON, from omnical detect)");
             sub.add_option("--sensor", options->sensor_path,
                            "Sensor guess (YAML): nominal design values. Without it the fit starts from the mirror's "
-                           "rim circle in the images (orthographic lens, scale held; see --lens)");
+                           "rim circle in the images (the lens chosen by held-out folds; see --lens)");
             sub.add_option("--profile", library.profile,
                            "Mirror family to fit: " + JoinChoices(ProfileNames(false)) +
                                " (polynomial by default without a guess; a hyperboloid needs --sensor); a guess of "

@@ -21,14 +21,15 @@ void AddGeneralisationFlags(CLI::App& sub, CalibrationOptions* library) {
                  "Distance of the cross-validation comparison (mm from the reflection point; default: the first "
                  "--distance-mm / --distance-n, else 2000)")
       ->check(kPositive);
-  sub.add_option("--lens", library->lens, "Without a guess: the lens the rim circle starts: orthographic (default), "
-                 "pinhole (a perspective camera; with a free-form mirror m and decenter held as gauges) or auto: the "
-                 "one predicting held-out folds better (calibration.json lens_choice)")
+  sub.add_option("--lens", library->lens, "Without a guess: the lens the rim circle starts: auto (default: the one "
+                 "predicting held-out folds of the views better, calibration.json lens_choice; the orthographic "
+                 "with under 4 views), orthographic (telecentric) or pinhole (a perspective camera; with a "
+                 "free-form mirror m and decenter held as gauges)")
       ->check(CLI::IsMember({"orthographic", "pinhole", "auto"}));
   sub.add_option("--tangential", library->tangential,
-                 "A pinhole's tangential distortion p1, p2 (a decentred lens): off (default, held at the start's "
-                 "values), on (fitted) or auto: fitted only where that predicts held-out folds better by > 1 % "
-                 "(calibration.json tangential_choice)")
+                 "A pinhole's tangential distortion p1, p2 (a decentred lens): off (held at the start's values; "
+                 "the default with a guess), on (fitted) or auto (the default without one): fitted only where that "
+                 "predicts held-out folds better by > 1 % (calibration.json tangential_choice)")
       ->check(CLI::IsMember({"off", "on", "auto"}));
   sub.add_flag("--leave-one-out", library->leave_one_out,
                "Also fit without each image in turn; calibration.json gets each parameter's spread");

@@ -129,8 +129,8 @@ if [ -n "$python" ]; then
   printf '400,-150,60\n' >"$work/point.csv"
   expected=$("$prefix/bin/omnical" project --sensor "$data/sensors/ohte-sph.yaml" --points "$work/point.csv" | tail -1)
   (cd "$work" && PYTHONPATH="$site" "$python" - "$data/sensors/ohte-sph.yaml" "$expected" "$site" \
-     "$data/targets/aprilgrid-6x6-30mm.yaml" "$data/rendered/ohte-sph-near/near000.png" "$plugin") <<'PY' ||
-    fail "python: the installed package"
+     "$data/targets/aprilgrid-6x6-30mm.yaml" "$data/rendered/ohte-sph-near/near000.png" "$plugin") <<'PY' \
+     || fail "python: the installed package"
 import os
 import sys
 import omnical

@@ -268,7 +268,8 @@ def test_load_calibration_round_trip(runs, tmp_path):
 
 
 def test_calibrate_from_detections_without_guess_with_leave_one_out(runs, tmp_path):
-    """The rim-circle start and leave-one-out, from four views of the CLI's detections: both front ends."""
+    """The rim-circle start (the lens chosen by default) and leave-one-out, from four views of the CLI's detections:
+    both front ends."""
     subset = json.loads((runs.out / "cli" / "detections.json").read_text())
     subset["images"] = subset["images"][:4]
     detections = tmp_path / "four.json"
@@ -286,6 +287,9 @@ def test_calibrate_from_detections_without_guess_with_leave_one_out(runs, tmp_pa
     assert done.returncode == 0, done.stderr
     assert result.detections is None and result.fixed_blocks >= {"tilt"} and result.robust_loss_px == 2
     assert [p["distance_mm"] for p in result.predicted_error][:1] == [500]
+    # Without a guess the lens is chosen by held-out folds by default (4 views: 4 folds).
+    assert result.lens_choice is not None and result.lens_choice["folds"] == 4, result.lens_choice
+    assert result.lens_choice["chosen"] == result.sensor.lens and "(chosen by held-out folds)" in result.start
     cli = json.loads((tmp_path / "cli" / "calibration.json").read_text())
     assert_json_equal(json.loads(result.to_json()), cli)
     rim = result.rim_circle
@@ -615,10 +619,10 @@ def test_bad_option_values_name_the_argument(runs, tmp_path):
     # lens is orthographic), with the CLI's text (which names its flag).
     with pytest.raises(omnical.InputError, match=r"^tangential: off, on or auto \(got 'yes'\)"):
         omnical.calibrate(TARGET, detections=detections, tangential="yes")
-    orthographic = cli_error(run_cli("calibrate", "--target", TARGET, "--detections", detections, "--tangential",
-                                     "auto", "--out", tmp_path / "tangential"))
+    orthographic = cli_error(run_cli("calibrate", "--target", TARGET, "--detections", detections, "--lens",
+                                     "orthographic", "--tangential", "auto", "--out", tmp_path / "tangential"))
     with pytest.raises(omnical.InputError) as caught:
-        omnical.calibrate(TARGET, detections=detections, tangential="auto")
+        omnical.calibrate(TARGET, detections=detections, lens="orthographic", tangential="auto")
     assert orthographic == "--" + str(caught.value) and orthographic.startswith("--tangential: the orthographic lens has no")
 
 

@@ -264,7 +264,7 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
   };
   cls.def_property_readonly(
       "lens_choice", [record, named_choice](const Holder& holder) { return named_choice(record(holder).lens_choice); },
-      "Without a guess, the lens chosen by held-out folds (lens='auto'): dict candidates, held_out_rms_px (per "
+      "Without a guess, the lens chosen by held-out folds (lens='auto', the default): dict candidates, held_out_rms_px (per "
       "candidate, NaN where it failed), held_out_corners, folds, chosen; None unless chosen.");
   cls.def_property_readonly(
       "tangential_choice",
@@ -727,10 +727,11 @@ target: a Target or a spec path. Corners: images (as detect(): a directory or gl
 list of paths or arrays, a dict name -> array) or detections (a Detections or a
 detections file), exactly one. guess: a Sensor or a sensor file (a file also brings its
 design tolerances, as --sensor); without one the fit starts from the mirror's rim circle
-(rim_field_deg: the rim ray's angle from the axis; lens: the lens it starts,
-'orthographic' ('' too), 'pinhole' or 'auto': chosen by held-out folds, result.lens_choice).
-tangential: a pinhole's p1, p2, 'off' ('' too: held), 'on' (fitted) or 'auto' (fitted where
-that predicts held-out folds better, result.tangential_choice). profile: mirror family to fit
+(rim_field_deg: the rim ray's angle from the axis; lens: the lens it starts, 'auto'
+('' too: chosen by held-out folds, result.lens_choice; the orthographic with under 4
+views), 'orthographic' or 'pinhole'). tangential: a pinhole's p1, p2, 'off' (held; '' with
+a guess), 'on' (fitted) or 'auto' ('' without a guess: fitted where that predicts held-out
+folds better, result.tangential_choice). profile: mirror family to fit
 (one of omnical.PROFILES but tabulated; '' the guess's). fixed: blocks held (lens,
 lens_scale, principal_point, distortion, tangential, m, tilt, decenter, shape, poses; a list or 'a,b').
 loss_px: Huber scale (0: least squares). detection_passes: 2 re-detects through the
