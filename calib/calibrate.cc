@@ -687,8 +687,16 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     while (fit.sensor && input.guess && !screen_stopped) {
       BoardSizeScreenOptions screen_options;
       screen_options.threads = options.threads;
-      const BoardSizeScreen screen =
-          ScreenBoardSizes(start, input.target, views.detections, fit, fit_options, screen_options);
+      // Through a flat board: the board's warp, shared by every view, bends towards a
+      // decoy's size as the sensor does (a 4 x giant among 8 views was no longer refused
+      // with the warp free: the fit went 6.5 tolerances off in m and past a valid sphere).
+      FitOptions flat_options = fit_options;
+      flat_options.fit_board_warp = false;
+      const FitResult flat = fit_options.fit_board_warp
+                                 ? FitSensor(start, input.target, views.detections, views.poses, flat_options)
+                                 : FitResult();
+      const BoardSizeScreen screen = ScreenBoardSizes(start, input.target, views.detections,
+                                                      fit_options.fit_board_warp ? flat : fit, flat_options, screen_options);
       const std::vector<size_t>& refused = screen.refused;
       if (refused.empty()) return;
       if (refused_so_far + refused.size() > max_refused) {

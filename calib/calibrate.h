@@ -85,8 +85,10 @@ struct CalibrationOptions {
   // training ratios of 0.83-1.42, pooled 1.09 (docs/calibrate.md). Not with holdout_views.
   // The folds reuse the full set's first detection pass (no fold changes it).
   int holdout_folds = 0;
-  // Fit the board's out-of-plane warp (calib/board_warp.h) with the sensor.
-  bool board_warp = false;
+  // Fit the board's out-of-plane warp (calib/board_warp.h) with the sensor. On by default,
+  // as mrcal fits its calobject_warp: hand-held paper bends, and a flat board costs two
+  // parameters found ~0 (docs/calibrate.md, "Bent boards").
+  bool board_warp = true;
   // Weight each view's corners by its own noise (FitOptions::view_noise_weights).
   bool view_weights = false;
   // How a checkerboard's corners are refined through the first fit (second detection pass).

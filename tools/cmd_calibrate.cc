@@ -125,9 +125,9 @@ Command CalibrateCommand() {
                            "Warn when the predicted projection error anywhere in the observed field exceeds this")
                 ->check(CLI::Range(0.0, 1000.0))->capture_default_str();
             AddGeneralisationFlags(sub, &library);
-            sub.add_flag("--board-warp", library.board_warp,
-                         "Also fit the board's out-of-plane warp (a paraboloid along each board axis, mm at the centre; "
-                         "paper boards bend)");
+            sub.add_flag("--board-warp,!--no-board-warp", library.board_warp,
+                         "Fit the board's out-of-plane warp with the sensor (a paraboloid along each board axis, mm at "
+                         "the centre; paper boards bend): the default; --no-board-warp holds the board flat");
             auto* edges = sub.add_flag("--checkerboard-edges", options->checkerboard_edges,
                                        "Refine checkerboard corners through the first fit by their edges (curves fitted "
                                        "across both sides of each junction), every corner: the default for a "

@@ -6,7 +6,8 @@
 # as on a full disk). Every row must end with exit code 2, one error line on stderr (after
 # any "omnical: warning:" lines, e.g. images skipped), within 60 s,
 # and leave nothing at its output path. Rows that accept the input (exit 0) are allowed
-# only where marked "accepted" (16-bit and colour images are converted, by design).
+# only where marked "accepted" (16-bit and colour images are converted, by design), and
+# required where marked "processed" (the input is valid but for what the row names).
 # Usage: bad_input_table.sh OMNICAL_BINARY SOURCE_DIR TABLE.md
 set -u
 omnical=$1
@@ -46,6 +47,10 @@ ffmpeg -loglevel error -y -i "$omni" -pix_fmt rgb24 "$f/colour/near000.png"
 ffmpeg -loglevel error -y -i "$omni" -vf scale=64:2 -pix_fmt gray "$f/strip/near000.png"  # AprilTag segfaulted on it
 head -c 300 "$omni" >"$f/truncated.png"
 "$omnical" -q remap --sensor "$sensor" --view panorama --size 64x16 --infinity --format opencv --out "$f/maps"
+# For the image the 16-bit and colour inputs were made from (a 1040 px render of the
+# misaligned sphere): the unwarp rows on them test the conversion, not the size check.
+"$omnical" -q remap --sensor "$data/sensors/ohte-sph-misaligned.yaml" --view panorama --size 64x16 --infinity \
+  --format opencv --out "$f/maps-1040"
 mkdir -p "$f/maps-corrupt" && cp "$f/maps/maps.yml.gz" "$f/maps-corrupt/" && echo '{"view": 3' >"$f/maps-corrupt/maps.json"
 sed "s#\\.\\./#$data/#; s/samples_per_pixel: [0-9]*/samples_per_pixel: -4/" "$data/scenes/ohte-sph-far.yaml" >"$f/scene-negative.yaml"
 sed "s#\\.\\./#$data/#; s/distance_n: \[37, 43\]/distance_n: [.nan, 43]/" "$data/scenes/ohte-sph-far.yaml" >"$f/scene-nan.yaml"
@@ -75,7 +80,7 @@ runner=("$omnical")
 # row SUBCOMMAND "INPUT" OUT EXPECT -- ARGS: OUT is the output path that must not exist
 # afterwards ("-": stdout only); EXPECT is "error" (exit 2), "write-error" (exit 2 when a
 # write fails: no temporary file may stay; files completed before the failure may) or
-# "accepted" (exit 0 allowed).
+# "accepted" (exit 0 allowed) or "processed" (exit 0 required).
 row() {
   local sub=$1 input=$2 out=$3 expect=$4
   shift 5
@@ -86,7 +91,8 @@ row() {
   message=$(grep -v '^omnical: warning: ' "$work/stderr" | head -1 | head -c 300 | sed "s#$work/##g; s#$source_dir/##g; s#|#/#g")
   if [ "$code" -eq 124 ]; then verdict="HANG"
   elif [ "$code" -gt 128 ]; then verdict="CRASH (signal $((code - 128)))"
-  elif [ "$expect" = accepted ] && [ "$code" -eq 0 ]; then verdict="accepted"; message="(processed)"
+  elif [ "$expect" = accepted ] || [ "$expect" = processed ] && [ "$code" -eq 0 ]; then verdict="accepted"; message="(processed)"
+  elif [ "$expect" = processed ]; then verdict="exit $code, expected 0"
   elif [ "$code" -ne 2 ]; then verdict="exit $code, expected 2"
   elif [ "$(grep -vc '^omnical: warning: ' "$work/stderr")" -ne 1 ]; then verdict="$(wc -l <"$work/stderr") stderr lines"
   elif [ "$expect" = write-error ] && [ -n "$(find "$out" \( -name '*.tmp*' -o -name '.tmp*' \) 2>/dev/null | head -1)" ]; then
@@ -94,7 +100,7 @@ row() {
   elif [ "$expect" != write-error ] && [ "$out" != - ] && [ -e "$out" ] && [ -n "$(find "$out" -type f 2>/dev/null | head -1)" ]; then
     verdict="left output"
   fi
-  [ "$expect" = accepted ] && [ "$code" -eq 0 ] && [ "$out" != - ] && rm -rf "$out"
+  [ "$code" -eq 0 ] && [ "$out" != - ] && rm -rf "$out"
   case $verdict in ok | accepted) pass ;; *) fail "$sub / $input: $verdict: $(head -3 "$work/stderr")"; bad=$((bad + 1)) ;; esac
   rows+=("| \`$sub\` | $input | $code | $message | $verdict, $((SECONDS - start)) s |")
 }
@@ -179,7 +185,7 @@ head -c 3000 "$omni" >"$f/garbage.mp4"
 row unwarp "missing video" "$o.avi" error -- unwarp --maps "$f/maps" --input "$f/none.avi" --out "$o.avi"
 row unwarp "empty video" "$o.avi" error -- unwarp --maps "$f/maps" --input "$f/empty.avi" --out "$o.avi"
 row unwarp "corrupt video" "$o.avi" error -- unwarp --maps "$f/maps" --input "$f/garbage.mp4" --out "$o.avi"
-row unwarp "16-bit input" "$o.png" accepted -- unwarp --maps "$f/maps" --input "$f/deep/near000.png" --out "$o.png"
+row unwarp "16-bit input" "$o.png" processed -- unwarp --maps "$f/maps-1040" --input "$f/deep/near000.png" --out "$o.png"
 row export-central "NaN distance" "$o" error -- export-central --sensor "$sensor" --model mei --distance-mm nan --out "$o"
 row export-central "distance 1e300 mm" "$o" error -- export-central --sensor "$sensor" --model mei --distance-mm 1e300 --out "$o"
 row export-central "infinite sphere radius" "$o" error -- export-central --sensor "$f/sensor-inf.yaml" --model mei --out "$o"

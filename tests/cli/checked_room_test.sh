@@ -52,7 +52,7 @@ for image in detections["images"]:
           (os.path.basename(image["image"]), errors[len(errors) // 2], errors[-1]))
 check(boards >= 6, "%d of 10 boards found" % boards)
 refused = open(stderr).read().count("a checkerboard-like grid refused")
-print("refused grids: %d" % refused)
+check(refused >= 1, "refused grids named on stderr: %d (measured 10)" % refused)
 
 truth = sphere_truth.truth_parameters(os.path.join(render, "sensor.yaml"))
 result = json.load(open(os.path.join(cal, "calibration.json")))

@@ -186,10 +186,18 @@ def test_record_fields_equal_cli_json(runs):
 
 
 def test_residuals_match_projection_of_fitted_poses(runs):
-    """Independent geometry: project the board corners through the fitted sensor and poses."""
+    """Independent geometry: project the board corners, bent by the fitted warp as documented, through the fitted
+    sensor and poses."""
     result = runs.result
     ids, board = omnical.Target.load(TARGET).points()
-    board_of = dict(zip(ids.tolist(), board))
+    # The warp (docs/calibrate.md, "Bent boards"): z += x_mm (1 - u^2) + y_mm (1 - v^2), u and v the corner's
+    # position scaled to [-1, 1] over the extent of the board's corners.
+    low, high = board[:, :2].min(axis=0), board[:, :2].max(axis=0)
+    unit = 2.0 * (board[:, :2] - low) / (high - low) - 1.0
+    assert result.board_warp is not None  # fitted by default
+    bent = board.copy()
+    bent[:, 2] += result.board_warp["x_mm"] * (1 - unit[:, 0] ** 2) + result.board_warp["y_mm"] * (1 - unit[:, 1] ** 2)
+    board_of = dict(zip(ids.tolist(), bent))
     views = {view.image: view for view in result.views.images}
     assert sorted(result.residuals) == sorted(views) and len(views) == len(result.poses)
     squares, worst = [], 0.0
@@ -320,7 +328,8 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
     assert omnical.load_calibration(tmp_path / "cli" / "calibration.json").holdout["views"] == held["views"]
     warp = result.board_warp
     assert close(warp["x_mm"], cli["board_warp"]["x_mm"]) and close(warp["std_y_mm"], cli["board_warp"]["std_y_mm"])
-    assert omnical.calibrate(TARGET, detections=detections, guess=GUESS, max_iterations=1).board_warp is None
+    assert omnical.calibrate(TARGET, detections=detections, guess=GUESS, max_iterations=1, board_warp=False).board_warp is None
+    assert omnical.calibrate(TARGET, detections=detections, guess=GUESS, max_iterations=1).board_warp is not None
     summary = result.summary()  # what the CLI prints without -q
     assert f"RMS {result.rms_px:.4f} px" in summary and f"ratio {held['rms_px'] / result.rms_all_px:.2f}" in summary
     assert f"{warp['x_mm']:.3f} +- {warp['std_x_mm']:.3f} mm along x" in summary and "differ at 1500 mm" in summary

@@ -245,7 +245,7 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
         return py::dict("x_mm"_a = w->warp.x_mm, "y_mm"_a = w->warp.y_mm, "std_x_mm"_a = w->std_x_mm,
                         "std_y_mm"_a = w->std_y_mm);
       },
-      "The board's fitted warp (board_warp=True): dict x_mm, y_mm (deflection at the centre along each board axis) "
+      "The board's fitted warp (board_warp=True, the default): dict x_mm, y_mm (deflection at the centre along each board axis) "
       "and their std_x_mm, std_y_mm; None unless fitted.");
   cls.def_property_readonly(
       "knot_choice",
@@ -719,7 +719,7 @@ are also attributes here), the warnings with their codes, the views and residual
         "detection_passes"_a = 2, "threads"_a = 0, "leave_one_out"_a = false, "tolerances"_a = py::none(),
         "distances_mm"_a = std::vector<double>(), "distances_n"_a = std::vector<double>(),
         "max_predicted_error_px"_a = 0.3, "rim_field_deg"_a = kDefaultRimFieldDeg, "holdout"_a = 0, "holdout_folds"_a = 0,
-        "cross_validate"_a = false, "cross_validation_distance_mm"_a = 0.0, "board_warp"_a = false, "view_weights"_a = false,
+        "cross_validate"_a = false, "cross_validation_distance_mm"_a = 0.0, "board_warp"_a = true, "view_weights"_a = false,
         "checkerboard_edges"_a = py::none(), "knots"_a = 0, "lens"_a = "", "tangential"_a = "", "progress"_a = py::none(),
         R"(Calibrates the sensor (as `omnical calibrate`) -> CalibrationResult.
 
@@ -745,7 +745,8 @@ out once, K at a time, one calibration per fold (result.holdout_folds; the resul
 full set's). cross_validate: each half of the
 views calibrated and compared at cross_validation_distance_mm (0: the first distance
 asked, else 2000) after the best rigid alignment (result.cross_validation). board_warp:
-also fit the board's out-of-plane warp (result.board_warp, mm). view_weights: weight
+fit the board's out-of-plane warp (result.board_warp, mm; the default, False holds the
+board flat). view_weights: weight
 each view's corners by its own noise, estimated from its residuals
 (result.per_view_weight). checkerboard_edges: None (default) refines a checkerboard's
 corners through the first fit by their edges, every one, where that applies; True asks

@@ -342,7 +342,7 @@ def calibrate(target: Union[Target, _Path], images: Optional[_Images] = None, *,
               tolerances: Union[Mapping[str, float], str, None] = None, distances_mm: Sequence[float] = (),
               distances_n: Sequence[float] = (), max_predicted_error_px: float = 0.3, rim_field_deg: float = 105.0,
               holdout: int = 0, holdout_folds: int = 0, cross_validate: bool = False,
-              cross_validation_distance_mm: float = 0.0, board_warp: bool = False, view_weights: bool = False,
+              cross_validation_distance_mm: float = 0.0, board_warp: bool = True, view_weights: bool = False,
               checkerboard_edges: Optional[bool] = None,
               knots: Union[int, str] = 0, lens: str = "", tangential: str = "",
               progress: _Progress = None) -> CalibrationResult: ...
