@@ -593,6 +593,12 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   // Without a guess, the lens by held-out folds on the first pass's corners, before the
   // corners are refined through a fit with it (calib/lens_choice.h).
   const bool foldable = static_cast<int>(views.detections.images.size()) >= kMinViewsForFolds;
+  // p1, p2 asked for where the default cannot choose the lens: the orthographic it keeps has none.
+  if (lens_by_default && !foldable && !tangential_by_default && options.tangential != kTangentialOff)
+    throw InputError("tangential: the lens is chosen by held-out folds, which need >= " +
+                     std::to_string(kMinViewsForFolds) + " usable views (" +
+                     std::to_string(views.detections.images.size()) +
+                     " given), and the orthographic lens kept instead has no tangential distortion; give lens pinhole");
   if (options.lens == kChooseLens || (lens_by_default && foldable)) {
     std::vector<std::optional<FoldCandidate>> candidates;
     for (const std::string& lens : kLensCandidates) {
@@ -656,7 +662,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
                                       kTangentialScoreTolerance, input.target, views.detections, options.threads,
                                       "tangential", options.progress, {held_score, std::nullopt}));
     fit_options.refine.tangential = choice.chosen == kTangentialCandidates[1];
-    if (!choice.AnyScored())
+    if (!choice.AnyScored() && !tangential_by_default)
       warnings.push_back({WarningCode::kTangentialNotFitted, "tangential",
                           "neither held nor fitted p1, p2 could be fitted to every held-out fold of the views; they "
                           "are held"});
@@ -692,11 +698,13 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
       // with the warp free: the fit went 6.5 tolerances off in m and past a valid sphere).
       FitOptions flat_options = fit_options;
       flat_options.fit_board_warp = false;
-      const FitResult flat = fit_options.fit_board_warp
-                                 ? FitSensor(start, input.target, views.detections, views.poses, flat_options)
-                                 : FitResult();
-      const BoardSizeScreen screen = ScreenBoardSizes(start, input.target, views.detections,
-                                                      fit_options.fit_board_warp ? flat : fit, flat_options, screen_options);
+      flat_options.compute_covariance = false;  // the screen reads the poses and sigma only
+      flat_options.progress = nullptr;
+      FitResult flat;
+      if (fit_options.fit_board_warp) flat = FitSensor(start, input.target, views.detections, views.poses, flat_options);
+      const bool through_flat = flat.sensor.has_value();  // else (no warp, or that fit failed) the fit itself
+      const BoardSizeScreen screen = ScreenBoardSizes(start, input.target, views.detections, through_flat ? flat : fit,
+                                                      through_flat ? flat_options : fit_options, screen_options);
       const std::vector<size_t>& refused = screen.refused;
       if (refused.empty()) return;
       if (refused_so_far + refused.size() > max_refused) {

@@ -47,8 +47,10 @@ struct CalibrationRecord {
   std::optional<HeldOutFolds> holdout_folds;  // every view held out once (CalibrationOptions::holdout_folds)
   std::optional<BoardWarpEstimate> board_warp;  // when fitted (CalibrationOptions::board_warp)
   std::optional<KnotChoice> knot_choice;  // when chosen (CalibrationOptions::knots = kChooseKnots)
-  std::optional<NamedChoice> lens_choice;  // when chosen (CalibrationOptions::lens = kChooseLens)
-  // When chosen (CalibrationOptions::tangential = kChooseTangential, a pinhole).
+  // When chosen (CalibrationOptions::lens = kChooseLens, or unset without a guess).
+  std::optional<NamedChoice> lens_choice;
+  // When chosen (CalibrationOptions::tangential = kChooseTangential, or unset without a
+  // guess; a pinhole).
   std::optional<NamedChoice> tangential_choice;
   // The two halves' calibrations compared (CalibrationOptions::cross_validate). The diff's
   // per-pixel vectors are kept in memory for the report's figure; the file has the summary.

@@ -26,7 +26,7 @@ enum class WarningCode {
   kHeldOutWorse,              // held-out views fit much worse than the training views
   kKnotCountReplaced,         // subject: knots; the folds' count fitted no valid mirror, the next was used
   kLensNotChosen,             // subject: lens; neither lens predicted every held-out fold, the orthographic kept
-  kTangentialNotFitted,       // subject: tangential; asked for (on/auto) but not fitted: an orthographic lens chosen, or no candidate scored
+  kTangentialNotFitted,       // subject: tangential; asked for (on/auto, not by default) but not fitted: an orthographic lens chosen, or no candidate scored
   kBoardScreenStopped,        // the board-size screen would refuse more than a quarter of the views: it kept them
   kImageRimNotUsed,           // subject: rim_circle; the images' rim is not this fit's mirror rim: detection kept the fit's
 };

@@ -1,5 +1,5 @@
 // Whether a pinhole's tangential distortion (p1, p2: a decentred lens element,
-// model/lenses.h) is fitted. Held by default: the image shift it makes across the field
+// model/lenses.h) is fitted. Held by default with a guess (chosen here without one): the image shift it makes across the field
 // trades with the mirror's decenter and the principal point, so on a sensor without a
 // decentred lens it only fits noise (and a typical small decentring, p ~ 1e-3, is absorbed
 // to within the corners' noise: docs/calibrate.md, "A decentred lens"). Chosen here by

@@ -94,6 +94,7 @@ if [ "$sanitize_pass" = full ]; then
   too_slow+='|MonteCarloSpread|WrongBasin|LeavesOutAView|ToleranceEnters|NearOnlyDistortion|KeepsEveryCornerOfANearly|BoardScale'
   too_slow+='|install.find_package_consumers|UnwarpedPanorama'
   too_slow+='|RecoversTheTruthFromExactObservations/hyperboloid_pinhole_aligned|RecordRoundTripsThroughCalibrationJson'
+  too_slow+='|WithoutAGuessTheLensIsChosen'
 fi
 (cd "$sanitize_dir" && ctest --output-on-failure -j "$jobs" -LE 'bench|slow' -E "$too_slow" "$@")
 phase "done"

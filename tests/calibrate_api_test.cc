@@ -398,6 +398,16 @@ TEST(CalibrateApi, WithoutAGuessTheLensIsChosenWhereTheViewsAllowFolds) {
   EXPECT_FALSE(few.record.tangential_choice.has_value());
   EXPECT_STREQ(few.sensor.lens_name(), "orthographic");
   EXPECT_EQ(few.record.start, "rim circle, polynomial mirror, orthographic lens");
+  options.tangential = kTangentialOn;  // p1, p2 asked for where the lens cannot be chosen: refused, not dropped
+  try {
+    Calibrate(input, options);
+    ADD_FAILURE() << "tangential on with 3 views and the lens unset calibrated";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("tangential: the lens is chosen by held-out folds, which need >= 4 usable views"),
+              std::string::npos)
+        << e.what();
+  }
+  options.tangential.clear();
   options.lens = kChooseLens;
   try {
     Calibrate(input, options);

@@ -21,10 +21,10 @@ void AddGeneralisationFlags(CLI::App& sub, CalibrationOptions* library) {
                  "Distance of the cross-validation comparison (mm from the reflection point; default: the first "
                  "--distance-mm / --distance-n, else 2000)")
       ->check(kPositive);
-  sub.add_option("--lens", library->lens, "Without a guess: the lens the rim circle starts: auto (default: the one "
-                 "predicting held-out folds of the views better, calibration.json lens_choice; the orthographic "
-                 "with under 4 views), orthographic (telecentric) or pinhole (a perspective camera; with a "
-                 "free-form mirror m and decenter held as gauges)")
+  sub.add_option("--lens", library->lens, "Without a guess: the lens the rim circle starts: auto (the one predicting "
+                 "held-out folds of the views better, calibration.json lens_choice; needs 4 usable views), "
+                 "orthographic (telecentric) or pinhole (a perspective camera; with a free-form mirror m and "
+                 "decenter held as gauges). Unset: as auto, the orthographic with under 4 views")
       ->check(CLI::IsMember({"orthographic", "pinhole", "auto"}));
   sub.add_option("--tangential", library->tangential,
                  "A pinhole's tangential distortion p1, p2 (a decentred lens): off (held at the start's values; "

@@ -31,7 +31,9 @@ expect_error() {
   if [ "$lines" -ne 1 ]; then fail "$name: $lines lines on stderr, expected 1: $(cat "$work/stderr")"; return; fi
   if ! grep -qF -- "$expected" "$work/stderr"; then fail "$name: message lacks '$expected': $(cat "$work/stderr")"; return; fi
   # The temporary names of model/io/atomic_write.cc: OUT.tmp.PID (a file), .tmpPID-OUT (a directory).
-  if [ -e "$out" ] || ls -A "$(dirname "$out")" 2>/dev/null | grep -qF -e "$(basename "$out").tmp." -e "-$(basename "$out")"; then
+  local escaped
+  escaped=$(basename "$out" | sed 's/[][\.*^$()+?{}|]/\\&/g')
+  if [ -e "$out" ] || ls -A "$(dirname "$out")" 2>/dev/null | grep -qE "^($escaped\.tmp\.[0-9]+|\.tmp[0-9]+-$escaped)\$"; then
     fail "$name: left output behind at $out"
     return
   fi

@@ -269,7 +269,7 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
   cls.def_property_readonly(
       "tangential_choice",
       [record, named_choice](const Holder& holder) { return named_choice(record(holder).tangential_choice); },
-      "Whether a pinhole's p1, p2 are fitted, chosen by held-out folds (tangential='auto'): dict candidates (held, "
+      "Whether a pinhole's p1, p2 are fitted, chosen by held-out folds (tangential='auto', or unset without a guess): dict candidates (held, "
       "fitted), held_out_rms_px, held_out_corners, folds, chosen; None unless chosen.");
   cls.def_property_readonly(
       "holdout",
