@@ -118,10 +118,7 @@ expect_error unwritable_output "cannot create output file" -- project --sensor "
 json() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])" "$1" "$2"; }
 # near VALUE EXPECTED TOLERANCE NAME
 # A value that is no finite number (empty, None: a NaN in the JSON, nan) fails.
-near() {
-  python3 -c 'import math, sys; a, b, t = map(float, sys.argv[1:4]); sys.exit(not (math.isfinite(a) and abs(a - b) <= t))' \
-    "$1" "$2" "$3" 2>/dev/null && pass || fail "$4: $1, expected $2 +- $3"
-}
+near() { within "$1" "$2" "$3" && pass || fail "$4: $1, expected $2 +- $3"; }
 
 if "$omnical" -q characterize --sensor "$sensors/ohte-sph.yaml" --lens-f 11.6 --f-number 4 --pixel-um 5.2 \
     --focus-mm 212 --out "$work/char"; then

@@ -15,10 +15,6 @@ v = json.load(open(sys.argv[1]))
 for k in sys.argv[2].split('.'): v = v[k]
 print(v)" "$1/design.json" "$2"
 }
-# within VALUE EXPECTED TOLERANCE, below VALUE BOUND: false for anything but a finite number
-# (a missing key prints nothing, a NaN in the JSON None: awk took both for 0).
-within() { python3 -c 'import math, sys; v, e, t = map(float, sys.argv[1:4]); sys.exit(not (math.isfinite(v) and abs(v - e) <= t))' "$@" 2>/dev/null; }
-below() { python3 -c 'import math, sys; v, b = map(float, sys.argv[1:3]); sys.exit(not (math.isfinite(v) and v < b))' "$@" 2>/dev/null; }
 
 # Uniform (Sec. 3.2): phi0 = atan(d / (F0 - b)) = 25.70 deg; phi1, field vs SEED-NOTES.md.
 "$omnical" design ode --spec "$designs/gaechter-uniform.yaml" --out "$work/uniform" --quiet || fail "design ode uniform exited $?"

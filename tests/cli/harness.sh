@@ -11,6 +11,10 @@ failed=0
 pass() { passed=$((passed + 1)); }
 fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
 check() { if "$@"; then pass; else fail "$*"; fi; }
+# within VALUE EXPECTED TOLERANCE, below VALUE BOUND: false for anything but a finite number
+# (a missing key prints nothing, a NaN in the JSON None: awk took both for 0).
+within() { python3 -c 'import math, sys; v, e, t = map(float, sys.argv[1:4]); sys.exit(not (math.isfinite(v) and abs(v - e) <= t))' "$@" 2>/dev/null; }
+below() { python3 -c 'import math, sys; v, b = map(float, sys.argv[1:3]); sys.exit(not (math.isfinite(v) and v < b))' "$@" 2>/dev/null; }
 # summary NAME: prints the counts; its status is the script's result.
 summary() {
   echo "$1: $passed passed, $failed failed"
