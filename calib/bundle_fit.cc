@@ -668,7 +668,7 @@ class FitRun {
     wide.rim_radius_mm = std::min(1.15 * guess_.rim_radius_mm, 0.99 * guess_.mirror.MaxRadiusMm());
     const Eigen::Matrix3d camera_from_mirror = fitted.pose.CameraFromMirrorRotation();
     const Eigen::Vector3d mirror_origin = fitted.pose.CameraFromMirrorTranslation();
-    double widest_mm = fitted.rim_radius_mm;
+    double corners_mm = 0.0;
     for (const Residual& r : residuals_) {
       if (r.outlier) continue;
       const Eigen::Quaterniond rotation(rotations_[r.view][3], rotations_[r.view][0], rotations_[r.view][1], rotations_[r.view][2]);
@@ -677,11 +677,29 @@ class FitRun {
       Eigen::Vector3d mirror_point;
       if (wide.ReflectionPoint(in_camera, &mirror_point) != ProjectionStatus::kOk) continue;
       const Eigen::Vector3d in_mirror = camera_from_mirror.transpose() * (mirror_point - mirror_origin);
-      widest_mm = std::max(widest_mm, std::hypot(in_mirror.x(), in_mirror.y()));
+      corners_mm = std::max(corners_mm, std::hypot(in_mirror.x(), in_mirror.y()));
     }
     // A hair beyond the widest so that the corner itself projects inside.
-    if (widest_mm > fitted.rim_radius_mm)
-      fitted.rim_radius_mm = std::min(widest_mm * (1.0 + 1e-6), 0.99 * fitted.mirror.MaxRadiusMm());
+    const double enclosing_mm = std::min(corners_mm * (1.0 + 1e-6), 0.99 * fitted.mirror.MaxRadiusMm());
+    if (enclosing_mm > fitted.rim_radius_mm) fitted.rim_radius_mm = enclosing_mm;
+    // A rim past what the fitted lens can see would be written as a sensor nothing loads. A
+    // pinhole's start reaches 1.5 x past the nominal rim (calib/initial_sensor.h) in case
+    // the fit grows the mirror; it may shrink it instead (the hyperboloid-800x600 renders,
+    // --lens pinhole: the rim left at 30 mm, the mirror seen edge-on from 14.7 mm). Then the
+    // rim is drawn in to just inside the widest valid one (where the rays graze the mirror),
+    // enclosing the corners still.
+    if (fitted.rim_radius_mm > enclosing_mm && !ValidateSensorModel(fitted).empty()) {
+      Model trial = fitted;
+      trial.rim_radius_mm = enclosing_mm;
+      if (ValidateSensorModel(trial).empty()) {
+        double valid_mm = enclosing_mm, invalid_mm = fitted.rim_radius_mm;
+        for (int step = 0; step < 30; ++step) {  // to ~1e-9 of the span
+          trial.rim_radius_mm = 0.5 * (valid_mm + invalid_mm);
+          (ValidateSensorModel(trial).empty() ? valid_mm : invalid_mm) = trial.rim_radius_mm;
+        }
+        fitted.rim_radius_mm = std::max(enclosing_mm, 0.99 * valid_mm);
+      }
+    }
     return fitted;
   }
 

@@ -638,7 +638,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     if (!scored)
       warnings.push_back({WarningCode::kLensNotChosen, "lens",
                           "neither lens could be fitted to every held-out fold of the views (a view where no other "
-                          "reaches?); the " + choice.chosen + " lens is kept"});
+                          "reaches, or no valid sensor?); the " + choice.chosen + " lens is kept"});
     if (!tangential_by_default && options.tangential != kTangentialOff && choice.chosen == "orthographic")
       warnings.push_back({WarningCode::kTangentialNotFitted, "tangential",
                           "tangential " + options.tangential + ": the orthographic lens was chosen, which has no "

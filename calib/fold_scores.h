@@ -28,7 +28,7 @@ struct FoldCandidate {
 };
 
 struct FoldScores {
-  std::vector<double> held_out_rms_px;  // per candidate, NaN when a fold failed to fit
+  std::vector<double> held_out_rms_px;  // per candidate, NaN when a fold failed to fit (or to a valid sensor)
   int held_out_corners = 0;             // per candidate (the same corners for all)
   int folds = 0;
 };

@@ -37,7 +37,7 @@ int ParseKnotCount(const std::string& text, const std::string& field);
 struct KnotChoice {
   std::string base_profile;  // candidate 0: the mirror family without a spline
   std::vector<int> candidates;
-  std::vector<double> held_out_rms_px;  // per candidate, NaN when a fold failed to fit
+  std::vector<double> held_out_rms_px;  // per candidate, NaN when a fold failed to fit (or to a valid mirror)
   int held_out_corners = 0;             // per candidate (the same corners for all)
   int folds = 0;
   // The count the sensor was fitted with: PreferredKnotCount's among every candidate, or,

@@ -24,7 +24,7 @@ constexpr double kLensScoreTolerance = 0.01;
 
 // Calibrate scores kLensCandidates with ChooseByHeldOutFolds, each started from the rim
 // circle through its lens (none, scored NaN, where some view had no starting pose through
-// it). Where neither lens could be fitted to every fold the first is kept, with the
-// warning lens_not_chosen.
+// it). Where neither lens could be fitted to every fold (a held-out view posed, a valid
+// sensor fitted) the first is kept, with the warning lens_not_chosen.
 
 }  // namespace omnical

@@ -333,6 +333,40 @@ std::vector<TargetPose> StartingPoses(const Sensor& guess, const Truth& truth) {
   return poses;
 }
 
+// A start whose rim reaches past what its lens can see (a pinhole's start from the rim
+// circle reaches 1.5 x past the nominal rim, and a fit may shrink the mirror: see
+// FittedModel): the fitted sensor's rim is drawn in to a valid mirror, the sensor.yaml
+// calibrate writes loads, and every fitted corner still projects inside the rim. Before,
+// the start's rim was kept (hyperboloid-800x600 renders, --lens pinhole: a rim of 30 mm
+// on a mirror seen edge-on from 14.7 mm, a sensor.yaml nothing could load).
+TEST(BundleFit, ARimPastWhatTheLensSeesIsDrawnInToAValidMirror) {
+  const Truth truth = ExactObservations(LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-edi.yaml"));
+  SensorModel model = truth.sensor.model();
+  std::visit([](auto& m) { m.rim_radius_mm *= 3.0; }, model);
+  const Sensor start(model);
+  ASSERT_FALSE(ValidateSensorModel(start.model()).empty());  // the case this test is about
+  const FitResult fit = FitSensor(start, truth.target, truth.detections, StartingPoses(start, truth), FitOptions::DefaultsFor(start));
+  ASSERT_TRUE(fit.sensor.has_value());
+  EXPECT_LT(fit.rms_px, 1e-6) << fit.solver_report;
+  EXPECT_EQ(ValidateSensorModel(fit.sensor->model()), "");
+  EXPECT_LT(fit.sensor->rim_radius_mm(), start.rim_radius_mm());
+  // Inside the widest valid rim by the 1 % FittedModel leaves (rays graze the mirror there).
+  EXPECT_NE(ValidateSensorModel(SensorWithWiderRim(*fit.sensor, 1.02).model()), "");
+  std::map<int, Eigen::Vector3d> board_mm;
+  for (const TargetCorner& corner : truth.target.corners()) board_mm[corner.id] = corner.point_in_target;
+  int projected = 0;
+  for (size_t v = 0; v < truth.detections.images.size(); ++v)
+    for (const CornerObservation& corner : truth.detections.images[v].corners) {
+      const TargetPose& pose = fit.poses[v];
+      Eigen::Vector2d pixel;
+      const Eigen::Vector3d point =
+          pose.camera_from_target_rotation * board_mm.at(corner.id) + pose.camera_from_target_translation_mm;
+      EXPECT_EQ(fit.sensor->Project(point, &pixel), ProjectionStatus::kOk) << v << " " << corner.id;
+      ++projected;
+    }
+  EXPECT_EQ(projected, fit.observations);
+}
+
 // A board bent by 3 mm along x and -2 mm along y (a paper sheet's sag over 0.2 m): exact
 // corners of it give back the warp with the sensor, to the exact-observation tolerances
 // (1e-6 px RMS; 1e-5 mm on the warp: a 1e-5 mm sag moves a corner by ~1e-6 px at these
