@@ -102,6 +102,24 @@ double BulkSigma(const std::vector<double>& norms, double bulk_sigmas) {
   return count > 0 ? std::sqrt(square_sum / (2.0 * count)) : 1.0;
 }
 
+// The widest rim in [valid_mm, invalid_mm) that keeps `model` a valid sensor (valid at
+// valid_mm, not at invalid_mm): 1 % inside the limit, where the rays graze the mirror, its
+// shape stops being convex or the lens's distortion folds; never below valid_mm. Every
+// rim-dependent check fails for good once it fails (model/sensor_validation.cc), so a
+// bisection finds the limit.
+template <typename Model>
+double WidestValidRimMm(Model model, double valid_mm, double invalid_mm) {
+  const double floor_mm = valid_mm;
+  for (int step = 0; step < 30; ++step) {  // to ~1e-9 of the span
+    model.rim_radius_mm = 0.5 * (valid_mm + invalid_mm);
+    (ValidateSensorModel(model).empty() ? valid_mm : invalid_mm) = model.rim_radius_mm;
+  }
+  // Checked once more: a failure in a band narrower than the checks' radial sampling could
+  // make the bisection's assumption fail.
+  model.rim_radius_mm = std::max(floor_mm, 0.99 * valid_mm);
+  return ValidateSensorModel(model).empty() ? model.rim_radius_mm : floor_mm;
+}
+
 // One fit of one model type: the problem, its stages, and the result it fills.
 template <typename Model>
 class FitRun {
@@ -691,14 +709,7 @@ class FitRun {
     if (fitted.rim_radius_mm > enclosing_mm && !ValidateSensorModel(fitted).empty()) {
       Model trial = fitted;
       trial.rim_radius_mm = enclosing_mm;
-      if (ValidateSensorModel(trial).empty()) {
-        double valid_mm = enclosing_mm, invalid_mm = fitted.rim_radius_mm;
-        for (int step = 0; step < 30; ++step) {  // to ~1e-9 of the span
-          trial.rim_radius_mm = 0.5 * (valid_mm + invalid_mm);
-          (ValidateSensorModel(trial).empty() ? valid_mm : invalid_mm) = trial.rim_radius_mm;
-        }
-        fitted.rim_radius_mm = std::max(enclosing_mm, 0.99 * valid_mm);
-      }
+      if (ValidateSensorModel(trial).empty()) fitted.rim_radius_mm = WidestValidRimMm(fitted, enclosing_mm, fitted.rim_radius_mm);
     }
     return fitted;
   }
@@ -771,6 +782,18 @@ std::vector<ParameterEstimate> SensorParameters(const Sensor& sensor) {
       },
       sensor.model());
   return parameters;
+}
+
+Sensor SensorWithWidestValidRim(const Sensor& sensor, double max_factor) {
+  return std::visit(
+      [&](auto model) {
+        if (!ValidateSensorModel(model).empty()) return Sensor(model);
+        const double rim_mm = model.rim_radius_mm, widest_mm = std::min(max_factor * rim_mm, 0.99 * model.mirror.MaxRadiusMm());
+        model.rim_radius_mm = widest_mm;
+        if (!ValidateSensorModel(model).empty()) model.rim_radius_mm = WidestValidRimMm(model, rim_mm, widest_mm);
+        return Sensor(model);
+      },
+      sensor.model());
 }
 
 Sensor SensorWithWiderRim(const Sensor& sensor, double factor) {

@@ -120,6 +120,11 @@ std::map<std::string, double> ExpandTolerances(const std::map<std::string, doubl
 // evaluating corners the fit let stray past the rim, or parameter steps near it.
 Sensor SensorWithWiderRim(const Sensor& sensor, double factor);
 
+// The sensor with its rim up to `max_factor` times as wide, as far as it stays a valid
+// sensor (1 % inside the limit; the sensor unchanged if it is not valid itself): where
+// the fitted model still predicts, past the corners it was fitted on.
+Sensor SensorWithWidestValidRim(const Sensor& sensor, double max_factor);
+
 // The sensor with its parameters set to `values` (SensorParameters' order and units).
 Sensor SensorWithParameters(const Sensor& sensor, const std::vector<double>& values);
 

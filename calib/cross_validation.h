@@ -41,6 +41,9 @@ struct HeldOutViews {
   double rms_px = NAN;         // all held-out corners
   double inlier_rms_px = NAN;  // the corners the outlier rule keeps
   int corners = 0, outliers = 0;
+  // Detected corners of the posed views with no residual: no ray through the sensor even
+  // at its widest valid rim (a score without them flatters the sensor).
+  int unscored_corners = 0;
 };
 
 // Every view held out once (CalibrationOptions::holdout_folds): one calibration per fold,

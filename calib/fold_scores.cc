@@ -56,10 +56,11 @@ FoldScores ScoreByHeldOutFolds(const std::vector<FoldCandidate>& candidates, con
     if (fit.sensor && ValidateSensorModel(fit.sensor->model()).empty()) {
       if (fit.board_warp) options.board_warp = fit.board_warp->warp;
       const HeldOutViews held_out = EvaluateHeldOutViews(*fit.sensor, target, held, options);
-      // A view whose pose cannot be fitted through this sensor counts against the
-      // candidate as failing: its corners are not in the score, so a score without them
-      // would flatter.
-      score.failed = !held_out.not_evaluated.empty() || !(held_out.corners > 0);
+      // A view whose pose cannot be fitted through this sensor, or a corner of it with no
+      // residual, counts against the candidate as failing: its corners are not in the
+      // score, so a score without them would flatter, and the candidates are compared on
+      // the same corners.
+      score.failed = !held_out.not_evaluated.empty() || !(held_out.corners > 0) || held_out.unscored_corners > 0;
       score.square = held_out.rms_px * held_out.rms_px * held_out.corners;
       score.corners = held_out.corners;
     } else {

@@ -116,7 +116,7 @@ TEST(RealImages, MeiParabolicDetectsAndCalibrates) {
   // The lens, chosen by held-out folds (calibrate's lens = auto, calib/lens_choice.h):
   // this sensor's lens is telecentric, and a perspective camera in front of the polynomial
   // mirror fits its corners about as well but predicts left-out views worse. Measured on
-  // these corners (OpenCV's, unrefined): orthographic 0.4039 px, pinhole 0.4170 px held out.
+  // these corners (2026-11-29): orthographic 0.3838 px, pinhole 0.3995 px held out.
   CalibrationInput input;
   input.target = board;
   input.target_name = "mei-parabolic-checkerboard.yaml";
