@@ -709,7 +709,8 @@ class FitRun {
     if (fitted.rim_radius_mm > enclosing_mm && !ValidateSensorModel(fitted).empty()) {
       Model trial = fitted;
       trial.rim_radius_mm = enclosing_mm;
-      if (ValidateSensorModel(trial).empty()) fitted.rim_radius_mm = WidestValidRimMm(fitted, enclosing_mm, fitted.rim_radius_mm);
+      if (ValidateSensorModel(trial).empty())
+        fitted.rim_radius_mm = WidestValidRimMm(fitted, enclosing_mm, fitted.rim_radius_mm);
     }
     return fitted;
   }
@@ -788,7 +789,8 @@ Sensor SensorWithWidestValidRim(const Sensor& sensor, double max_factor) {
   return std::visit(
       [&](auto model) {
         if (!ValidateSensorModel(model).empty()) return Sensor(model);
-        const double rim_mm = model.rim_radius_mm, widest_mm = std::min(max_factor * rim_mm, 0.99 * model.mirror.MaxRadiusMm());
+        const double rim_mm = model.rim_radius_mm;
+        const double widest_mm = std::min(max_factor * rim_mm, 0.99 * model.mirror.MaxRadiusMm());
         model.rim_radius_mm = widest_mm;
         if (!ValidateSensorModel(model).empty()) model.rim_radius_mm = WidestValidRimMm(model, rim_mm, widest_mm);
         return Sensor(model);

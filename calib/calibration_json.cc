@@ -41,15 +41,16 @@ const char* const kLensChoiceDefinition =
     "the lens an unknown mirror is seen through, chosen by held-out folds on the first detection pass's corners: the "
     "usable views split into `folds` interleaved folds, each held out in turn while the rest are calibrated from the "
     "rim circle through every candidate lens; held_out_rms_px over every held-out corner of every fold (poses fitted, "
-    "sensor held), per corner sqrt(mean |e|^2), null where a fold failed (no fit, no valid sensor, or a held-out view or "
-    "corner without a residual through the lens); "
+    "sensor held), per corner sqrt(mean |e|^2), null where a fold failed (no fit, no valid sensor, or a held-out "
+    "view or corner without a residual through the lens); "
     "chosen: the first candidate within 1 % of the lowest, the first where none scored (warning lens_not_chosen)";
 const char* const kTangentialChoiceDefinition =
     "whether the pinhole's tangential distortion p1, p2 is fitted (candidate fitted) or held at the start's values "
     "(held), chosen by held-out folds on the first detection pass's corners: the usable views split into `folds` "
     "interleaved folds, each held out in turn while the rest are calibrated both ways; held_out_rms_px over every "
     "held-out corner of every fold (poses fitted, sensor held), per corner sqrt(mean |e|^2), null where a fold "
-    "failed (no fit, no valid sensor, or a held-out corner without a residual); chosen: the first candidate within 1 % of the lowest, the first where none scored";
+    "failed (no fit, no valid sensor, or a held-out corner without a residual); chosen: the first candidate within "
+    "1 % of the lowest, the first where none scored";
 const char* const kCrossValidationDefinition =
     "the usable views split into even and odd positions, each half calibrated alone; the points distance_mm along "
     "each observed field pixel's ray through half 1 (from its reflection point), moved by the rigid motion that "

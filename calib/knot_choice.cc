@@ -94,7 +94,8 @@ KnotChoice ChooseKnots(const Sensor& start, const std::string& base_profile, con
   choice.held_out_corners = scores.held_out_corners;
   choice.folds = scores.folds;
   const int preferred = PreferredKnotCount(choice, std::vector<bool>(choice.candidates.size(), false));
-  if (preferred < 0) throw InputError("knots: no knot count could be fitted to every fold of the views (each fold to a valid mirror)");
+  if (preferred < 0)
+    throw InputError("knots: no knot count could be fitted to every fold of the views (each fold to a valid mirror)");
   choice.chosen = choice.candidates[preferred];
   return choice;
 }

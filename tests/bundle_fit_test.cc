@@ -340,12 +340,14 @@ std::vector<TargetPose> StartingPoses(const Sensor& guess, const Truth& truth) {
 // the start's rim was kept (hyperboloid-800x600 renders, --lens pinhole: a rim of 30 mm
 // on a mirror seen edge-on from 14.7 mm, a sensor.yaml nothing could load).
 TEST(BundleFit, ARimPastWhatTheLensSeesIsDrawnInToAValidMirror) {
-  const Truth truth = ExactObservations(LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-edi.yaml"));
+  const Truth truth =
+      ExactObservations(LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-edi.yaml"));
   SensorModel model = truth.sensor.model();
   std::visit([](auto& m) { m.rim_radius_mm *= 3.0; }, model);
   const Sensor start(model);
   ASSERT_FALSE(ValidateSensorModel(start.model()).empty());  // the case this test is about
-  const FitResult fit = FitSensor(start, truth.target, truth.detections, StartingPoses(start, truth), FitOptions::DefaultsFor(start));
+  const FitResult fit =
+      FitSensor(start, truth.target, truth.detections, StartingPoses(start, truth), FitOptions::DefaultsFor(start));
   ASSERT_TRUE(fit.sensor.has_value());
   EXPECT_LT(fit.rms_px, 1e-6) << fit.solver_report;
   EXPECT_EQ(ValidateSensorModel(fit.sensor->model()), "");
