@@ -995,10 +995,17 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
       }
     }
   }
-  for (const CalibrationWarning& w : warnings)
-    if (w.code != WarningCode::kViewSkipped && w.code != WarningCode::kImageUnreadable &&
-        w.code != WarningCode::kImageSizeDiffers && w.code != WarningCode::kCheckerboardRefused)
+  for (const CalibrationWarning& w : warnings) {
+    const bool skipped = w.code == WarningCode::kViewSkipped || w.code == WarningCode::kImageUnreadable ||
+                         w.code == WarningCode::kImageSizeDiffers;
+    if (skipped) {
+      // The text is "<image>: <why>, [view ]skipped".
+      const std::string why = w.text.substr(std::min(w.text.size(), w.subject.size() + 2));
+      record.views_skipped[w.subject] = why.substr(0, why.rfind(", "));
+    } else if (w.code != WarningCode::kCheckerboardRefused) {
       record.warnings.push_back(w.text);
+    }
+  }
   for (size_t v = 0; v < usable.images.size(); ++v) record.per_view_rms_px[usable.images[v].image] = fit.per_view_rms_px[v];
   for (size_t v = 0; v < fit.per_view_weight.size(); ++v) record.per_view_weight[usable.images[v].image] = fit.per_view_weight[v];
   record.parameters = fit.parameters;

@@ -171,6 +171,7 @@ json ToJson(const CalibrationRecord& r) {
   }
   j["target_distance_mm"] = {{"nearest", r.nearest_target_mm}, {"farthest", r.farthest_target_mm}};
   for (const auto& [image, why] : r.views_left_out) j["views_left_out"][image] = why;
+  for (const auto& [image, why] : r.views_skipped) j["views_skipped"][image] = why;
   j["outlier_threshold_px"] = r.outlier_threshold_px;
   for (const auto& [image, count] : r.per_view_outliers) j["per_view_outliers"][image] = count;
   j["sigma_px"] = r.sigma_px;
@@ -317,6 +318,7 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
     r.nearest_target_mm = distance.at("nearest").is_null() ? HUGE_VAL : distance.at("nearest").get<double>();
     r.farthest_target_mm = distance.at("farthest").get<double>();
     if (j.contains("views_left_out")) r.views_left_out = at("views_left_out").get<std::map<std::string, std::string>>();
+    if (j.contains("views_skipped")) r.views_skipped = at("views_skipped").get<std::map<std::string, std::string>>();
     r.outlier_threshold_px = at("outlier_threshold_px").get<double>();
     if (j.contains("per_view_outliers")) r.per_view_outliers = at("per_view_outliers").get<std::map<std::string, int>>();
     r.sigma_px = at("sigma_px").get<double>();

@@ -62,6 +62,9 @@ struct CalibrationRecord {
   std::optional<CrossValidationRecord> cross_validation;
   double nearest_target_mm = 0.0, farthest_target_mm = 0.0;  // fitted views, from the lens
   std::map<std::string, std::string> views_left_out;          // image -> why
+  // Images no view was made of (unreadable, another size, no board or too few corners
+  // found, no starting pose): image -> why.
+  std::map<std::string, std::string> views_skipped;
   double outlier_threshold_px = 0.0;
   std::map<std::string, int> per_view_outliers;  // image -> corners cut
   double sigma_px = 0.0;

@@ -90,11 +90,11 @@ bool Grow(const cv::Mat& grey, double threshold, int longest, Grid* grid) {
 }
 
 // Whether at least three of the part's four sides show the board's white margin: a point
-// one step beyond a corner on that side that is no X-junction and has paper half a step
-// further out (brighter than the mean of the part's squares: the midpoint of ink and
-// paper). Growth stops at a margin, but also at the rim, a dark edge or the image's edge:
-// a patch of a larger pattern (tiles) cut there to the board's size shows no paper; a
-// board whose one side lies beyond the rim (realistic render rim0) shows it on three.
+// one step beyond a corner on that side that is no X-junction and has paper further out
+// (brighter than the mean of the part's squares: the midpoint of ink and paper). Growth
+// stops at a margin, but also at the rim, a dark edge or the image's edge: a patch of a
+// larger pattern (tiles) cut there to the board's size shows no paper; a board whose one
+// side lies beyond the rim (realistic render rim0) shows it on three.
 bool MarginOnThreeSides(const cv::Mat& grey, double threshold, const Grid& grid) {
   double square_sum = 0.0;
   int squares = 0;
@@ -119,9 +119,17 @@ bool MarginOnThreeSides(const cv::Mat& grey, double threshold, const Grid& grid)
       const Eigen::Vector2d across = StepAcross(grid, index, side.dr, side.dc);
       if (!on_side || across.isZero() || !Predict(grid, index, side.dr, side.dc, &beyond)) continue;
       const double score = XJunctionScore(grey, beyond, beyond - pixel, across);
-      const Eigen::Vector2d paper = beyond + 0.5 * (beyond - pixel);
-      const double paper_grey = Bilinear<uchar>(grey, paper.x(), paper.y());
-      if (std::isfinite(score) && score <= threshold && paper_grey > ink_paper_midpoint) margin_seen = true;
+      if (!std::isfinite(score) || score > threshold) continue;
+      // Paper half a step out, or a quarter step out beside both outer squares (a narrow or
+      // shaded margin shows paper only close to the print: Mei's board at 640 px by the inner
+      // radius read 112-144 half a step out on two sides against a midpoint of 154, and 182
+      // and 171 a quarter step out). Both, because beyond a tile patch's last junctions the
+      // next squares alternate ink and paper along the side; a margin runs along it.
+      const auto paper_at = [&](double out, double along_side) {
+        const Eigen::Vector2d at = beyond + out * (beyond - pixel) + along_side * across;
+        return Bilinear<uchar>(grey, at.x(), at.y()) > ink_paper_midpoint;
+      };
+      if (paper_at(0.5, 0.0) || (paper_at(0.25, -0.5) && paper_at(0.25, 0.5))) margin_seen = true;
     }
     sides_with_margin += margin_seen;
   }

@@ -148,6 +148,11 @@ TEST(CalibrateApi, RecordRoundTripsThroughCalibrationJson) {
   EXPECT_EQ(tangential_back.tangential_choice->chosen, "fitted");
   EXPECT_EQ(tangential_back.lens_choice->chosen, "orthographic");
   EXPECT_EQ(CalibrationJsonText(tangential_back), CalibrationJsonText(chosen));
+  // Images no view was made of, with the reason.
+  chosen.views_skipped = {{"a.png", "no tag of the target found"}, {"b.png", "cannot read the image"}};
+  const CalibrationRecord skipped_back = ParseCalibrationJson(CalibrationJsonText(chosen), "memory");
+  EXPECT_EQ(skipped_back.views_skipped, chosen.views_skipped);
+  EXPECT_EQ(CalibrationJsonText(skipped_back), CalibrationJsonText(chosen));
 }
 
 // A view whose corners are all wrong is left out: its RMS is written as null and must read

@@ -1141,12 +1141,14 @@ namespace omnical {
 namespace {
 
 // A flat printed board on grey: squares_x x squares_y squares of 24 px (ink at the top-left
-// square), a white margin of one square, its first inner corner at `origin`.
-cv::Mat FlatBoard(int squares_x, int squares_y, cv::Point origin, cv::Size image_size) {
+// square), a white margin of margin_px (one square), its first inner corner at `origin`.
+cv::Mat FlatBoard(int squares_x, int squares_y, cv::Point origin, cv::Size image_size, int margin_px = 24) {
   constexpr int kSquarePx = 24;
   cv::Mat image(image_size, CV_8UC1, cv::Scalar(120));
   const cv::Point top_left = origin - cv::Point(kSquarePx, kSquarePx);
-  cv::rectangle(image, cv::Rect(top_left - cv::Point(kSquarePx, kSquarePx), cv::Size((squares_x + 2) * kSquarePx, (squares_y + 2) * kSquarePx)),
+  cv::rectangle(image,
+                cv::Rect(top_left - cv::Point(margin_px, margin_px),
+                         cv::Size(squares_x * kSquarePx + 2 * margin_px, squares_y * kSquarePx + 2 * margin_px)),
                 cv::Scalar(235), cv::FILLED);
   for (int y = 0; y < squares_y; ++y)
     for (int x = 0; x < squares_x; ++x)
@@ -1233,6 +1235,35 @@ TEST(PartialCheckerboard, PlacesABoardThatSpansItsExtentOnly) {
 
   const cv::Mat tiles = FlatBoard(16, 12, cv::Point(24, 24), cv::Size(400, 320));
   EXPECT_FALSE(FindPartialCheckerboard(tiles, pattern));
+}
+
+// A narrow margin (a third of a square, grey beyond: as Mei's hand-held board read at 640 px
+// by the inner radius, where a view through the first fit lost it) is still a margin; the
+// same broken beside every other square, as a tile pattern's next row would be, is not.
+TEST(PartialCheckerboard, PlacesABoardWithANarrowMarginNotABrokenOne) {
+  const cv::Size pattern(8, 6);
+  const std::optional<PartialCheckerboard> narrow =
+      FindPartialCheckerboard(FlatBoard(9, 7, cv::Point(80, 70), cv::Size(400, 320), 8), pattern);
+  ASSERT_TRUE(narrow);
+  EXPECT_TRUE(narrow->placed);
+  EXPECT_EQ(narrow->corners.size(), 48u);
+
+  // The same narrow margin broken beside every other outer square (grey there, as the next
+  // row of a tile pattern alternates beyond its last junctions): no side shows a margin.
+  cv::Mat broken = FlatBoard(9, 7, cv::Point(80, 70), cv::Size(400, 320), 8);
+  const cv::Rect print(80 - 24, 70 - 24, 9 * 24, 7 * 24);
+  for (int k = 0; k < 9; k += 2) {
+    broken(cv::Rect(print.x + k * 24, print.y - 8, 24, 8)).setTo(120);
+    broken(cv::Rect(print.x + k * 24, print.br().y, 24, 8)).setTo(120);
+  }
+  for (int k = 0; k < 7; k += 2) {
+    broken(cv::Rect(print.x - 8, print.y + k * 24, 8, 24)).setTo(120);
+    broken(cv::Rect(print.br().x, print.y + k * 24, 8, 24)).setTo(120);
+  }
+  const std::optional<PartialCheckerboard> patch = FindPartialCheckerboard(broken, pattern);
+  ASSERT_TRUE(patch) << "OpenCV no longer finds the board: the case is not tested";
+  EXPECT_EQ(patch->corners.size(), 48u);
+  EXPECT_FALSE(patch->placed);
 }
 
 }  // namespace

@@ -167,6 +167,7 @@ def test_record_fields_equal_cli_json(runs):
     assert result.guess_rim_radius_mm == pytest.approx(cli["rim_radius_mm"]["guess"], rel=TOLERANCE)
     assert result.fitted_rim_radius_mm == pytest.approx(cli["rim_radius_mm"]["fitted"], rel=TOLERANCE)
     assert result.views_left_out == cli.get("views_left_out", {})
+    assert result.views_skipped == cli.get("views_skipped", {})
     assert result.per_view_outliers == cli.get("per_view_outliers", {})
     assert_json_equal(result.tolerances, cli["tolerances"] or {})
     assert result.rim_circle is None and "rim_circle" not in cli  # started from the guess
@@ -428,6 +429,23 @@ def test_view_weights_equal_cli(runs, tmp_path):
     assert max(scaled) < 1.15 * min(scaled), scaled
     assert not omnical.calibrate(TARGET, detections=detections, guess=GUESS).per_view_weight
     assert "per_view_weight" not in json.loads((runs.out / "cli" / "calibration.json").read_text())
+
+
+def test_views_skipped_equal_cli(runs, tmp_path):
+    """An image in which nothing was found is named with the reason: views_skipped in both
+    front ends and calibration.json, and the CLI's warning line."""
+    detections = json.loads((runs.out / "cli" / "detections.json").read_text())
+    detections["images"].append({"image": "empty.png", "corners": []})
+    path = tmp_path / "detections.json"
+    path.write_text(json.dumps(detections))
+    result, done = beside_cli(
+        ["calibrate", "--target", TARGET, "--detections", path, "--sensor", GUESS, "--out", tmp_path / "cli"],
+        lambda: omnical.calibrate(TARGET, detections=path, guess=GUESS))
+    assert done.returncode == 0, done.stderr
+    expected = {"empty.png": "no tag of the target found"}
+    assert result.views_skipped == expected
+    assert json.loads((tmp_path / "cli" / "calibration.json").read_text())["views_skipped"] == expected
+    assert "omnical: warning: empty.png: no tag of the target found, view skipped" in done.stderr.splitlines()
 
 
 # --- detect ------------------------------------------------------------------------------

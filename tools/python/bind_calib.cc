@@ -190,6 +190,8 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
   field("nearest_target_mm", &CalibrationRecord::nearest_target_mm, "Distance of the nearest fitted board from the lens (mm).");
   field("farthest_target_mm", &CalibrationRecord::farthest_target_mm, "Distance of the farthest fitted board (mm).");
   field("views_left_out", &CalibrationRecord::views_left_out, "dict image -> why it was left out of the fit.");
+  field("views_skipped", &CalibrationRecord::views_skipped,
+        "dict image -> why no view was made of it (unreadable, another size, no board found, no starting pose).");
   field("outlier_threshold_px", &CalibrationRecord::outlier_threshold_px, "|residual| beyond which corners were removed (px).");
   field("per_view_outliers", &CalibrationRecord::per_view_outliers, "dict image -> corners removed as outliers.");
   field("sigma_px", &CalibrationRecord::sigma_px, "Corner noise per coordinate the covariance is scaled by (px).");
