@@ -999,9 +999,15 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     const bool skipped = w.code == WarningCode::kViewSkipped || w.code == WarningCode::kImageUnreadable ||
                          w.code == WarningCode::kImageSizeDiffers;
     if (skipped) {
-      // The text is "<image>: <why>, [view ]skipped".
-      const std::string why = w.text.substr(std::min(w.text.size(), w.subject.size() + 2));
-      record.views_skipped[w.subject] = why.substr(0, why.rfind(", "));
+      // The reason without the image's name and ", [view ]skipped" around it (the whole
+      // line should a message not read so).
+      const std::string prefix = w.subject + ": ";
+      const std::string suffix = w.code == WarningCode::kViewSkipped ? ", view skipped" : ", skipped";
+      const size_t length = w.text.size();
+      const bool framed = length >= prefix.size() + suffix.size() && w.text.compare(0, prefix.size(), prefix) == 0 &&
+                          w.text.compare(length - suffix.size(), suffix.size(), suffix) == 0;
+      record.views_skipped[w.subject] =
+          framed ? w.text.substr(prefix.size(), length - prefix.size() - suffix.size()) : w.text;
     } else if (w.code != WarningCode::kCheckerboardRefused) {
       record.warnings.push_back(w.text);
     }

@@ -1,7 +1,8 @@
 // Real images: C. Mei's paracatadioptric sample set in ../shared/real-data/mei-parabolic
 // (read in place, never copied; the test skips where the folder is absent). The
 // checkerboard is detected in every image and agrees with the 2007 reference corners, and
-// the unknown-mirror mode (even polynomial, orthographic lens) calibrates all 10 views.
+// the unknown-mirror mode (even polynomial, orthographic lens) calibrates all 10 views, also
+// from the images scaled to 640 px and saved as JPEG.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -11,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <set>
 #include <sstream>
@@ -199,12 +201,6 @@ TEST(RealImages, MeiParabolicGeneralisesWithinTheIssuesBounds) {
               record.rms_all_px, record.outliers, record.cross_validation->diff.rms_px, folds.rms_px,
               folds.training_rms_px);
 }
-
-}  // namespace
-}  // namespace omnical
-
-namespace omnical {
-namespace {
 
 // The user the issue describes: the same sensor's images at 640 x 512 px and JPEG quality 75
 // (area-averaged from 1280 x 1024), calibrated with the defaults from the images alone. Every

@@ -16,6 +16,7 @@ import argparse
 import glob
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -75,16 +76,19 @@ def main():
         done = subprocess.run([args.omnical, "-q", "calibrate", "--target", TARGET, "--images", images,
                                "--cross-validate", "--out", calibration], capture_output=True, text=True)
         if done.returncode != 0:
-            print(f"| {name} | calibrate failed: {done.stderr.strip().splitlines()[-1]} | | | | |")
+            last = (done.stderr.strip().splitlines() or [f"exit status {done.returncode}"])[-1]
+            print(f"| {name} | calibrate failed: {last} | | | | |")
             continue
-        record = json.load(open(os.path.join(calibration, "calibration.json")))
-        skipped = "; ".join(f"{os.path.basename(image)}: {why}" for image, why in record.get("views_skipped", {}).items())
+        with open(os.path.join(calibration, "calibration.json")) as file:
+            record = json.load(file)
+        skipped = "; ".join(f"{os.path.basename(image)}: {why}"
+                            for image, why in record.get("views_skipped", {}).items())
         halves = record["cross_validation"]
         print(f"| {name} | {len(record['poses'])} of {len(sources)} | {record['observations']} | {skipped or 'none'} "
               f"| {record['rms_px']:.3f} / {record['rms_all_px']:.3f} "
               f"| {halves['diff_rms_px']:.3f} / {halves['diff_max_px']:.3f} |", flush=True)
     if not args.keep:
-        subprocess.run(["rm", "-rf", work])
+        shutil.rmtree(work)
 
 
 if __name__ == "__main__":
