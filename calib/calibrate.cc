@@ -88,7 +88,7 @@ UsableViews ViewsForFit(const Sensor& start, const CalibrationInput& input, cons
               ? "no complete checkerboard of " + std::to_string(input.target.cols()) + " x " +
                     std::to_string(input.target.rows()) + " inner corners found"
               : "no tag of the target found";
-      warnings->push_back({WarningCode::kViewSkipped, image.image, image.image + ": " + why + ", view skipped"});
+      warnings->push_back({WarningCode::kViewSkipped, image.image, image.image + ": " + why + ", view skipped", why});
       continue;
     }
     views.detections.images.push_back(image);
@@ -999,15 +999,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     const bool skipped = w.code == WarningCode::kViewSkipped || w.code == WarningCode::kImageUnreadable ||
                          w.code == WarningCode::kImageSizeDiffers;
     if (skipped) {
-      // The reason without the image's name and ", [view ]skipped" around it (the whole
-      // line should a message not read so).
-      const std::string prefix = w.subject + ": ";
-      const std::string suffix = w.code == WarningCode::kViewSkipped ? ", view skipped" : ", skipped";
-      const size_t length = w.text.size();
-      const bool framed = length >= prefix.size() + suffix.size() && w.text.compare(0, prefix.size(), prefix) == 0 &&
-                          w.text.compare(length - suffix.size(), suffix.size(), suffix) == 0;
-      record.views_skipped[w.subject] =
-          framed ? w.text.substr(prefix.size(), length - prefix.size() - suffix.size()) : w.text;
+      record.views_skipped[w.subject] = w.reason;
     } else if (w.code != WarningCode::kCheckerboardRefused) {
       record.warnings.push_back(w.text);
     }

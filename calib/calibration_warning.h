@@ -39,6 +39,7 @@ struct CalibrationWarning {
   WarningCode code;
   std::string subject;  // image path or parameter name; empty if about the whole run
   std::string text;     // one line, complete
+  std::string reason{};  // a skipped image's: why, alone (CalibrationRecord::views_skipped)
 };
 
 }  // namespace omnical

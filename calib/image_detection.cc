@@ -107,7 +107,7 @@ DetectedImages DetectAll(const CalibrationTarget& target, size_t count, const st
       out.warnings.push_back({WarningCode::kCheckerboardRefused, name(i), name(i) + ": a checkerboard-like grid refused: " + why});
     if (!image.problem.empty()) {
       out.warnings.push_back({image.size.empty() ? WarningCode::kImageUnreadable : WarningCode::kImageSizeDiffers, name(i),
-                              name(i) + ": " + image.problem + ", skipped"});
+                              name(i) + ": " + image.problem + ", skipped", image.problem});
       continue;
     }
     out.detections.images.push_back(std::move(image.found));
