@@ -22,6 +22,7 @@
 #include "calib/initial_sensor.h"
 #include "calib/knot_choice.h"
 #include "calib/predicted_error.h"
+#include "calib/profile_choice.h"
 #include "calib/tangential_choice.h"
 #include "calib/target.h"
 #include "model/progress.h"
@@ -44,7 +45,11 @@ struct CalibrationInput {
 };
 
 struct CalibrationOptions {
-  std::string profile;  // mirror family to fit ("": the guess's; polynomial without a guess)
+  // Mirror family to fit: "" the guess's; without a guess kChooseProfile (the polynomial or
+  // the even asphere by held-out folds, calib/profile_choice.h) where the usable views allow
+  // folds, else the polynomial. kChooseProfile only without a guess. The folds of
+  // holdout_folds keep the family the full set used.
+  std::string profile;
   double rim_field_deg = kDefaultRimFieldDeg;
   // Without a guess, the lens the rim circle starts (calib/initial_sensor.h):
   // "orthographic" (a telecentric lens), "pinhole" (a perspective camera in front of the
@@ -68,6 +73,9 @@ struct CalibrationOptions {
   std::set<std::string> fixed;  // blocks held, by RefineOptions::Hold's names (calib/fit_options.h)
   double loss_px = 1.0;
   int max_iterations = 200;
+  // From images: 2 re-detects through the first fit, 3 through the second (checkerboards:
+  // only where it finds more boards). Boards a checkerboard's last pass found get one pass
+  // more (record.detection_passes counts the passes run).
   int detection_passes = 2;
   int threads = 1;  // detection, the board-size checks and the fit's Jacobians (the same result for any count)
   bool leave_one_out = false;

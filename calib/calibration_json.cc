@@ -44,6 +44,13 @@ const char* const kLensChoiceDefinition =
     "sensor held), per corner sqrt(mean |e|^2), null where a fold failed (no fit, no valid sensor, or a held-out "
     "view or corner without a residual through the lens); "
     "chosen: the first candidate within 1 % of the lowest, the first where none scored (warning lens_not_chosen)";
+const char* const kProfileChoiceDefinition =
+    "the mirror family an unknown mirror is fitted as (polynomial: the 3-term even polynomial; even_asphere: a conic), "
+    "chosen by held-out folds on the first detection pass's corners through the lens chosen: the usable views split "
+    "into `folds` interleaved folds, each held out in turn while the rest are calibrated from the rim circle as every "
+    "candidate family; held_out_rms_px over every held-out corner of every fold (poses fitted, sensor held), per "
+    "corner sqrt(mean |e|^2), null where a fold failed (no fit, no valid sensor, or a held-out view or corner without "
+    "a residual); chosen: the first candidate within 1 % of the lowest, the first where none scored";
 const char* const kTangentialChoiceDefinition =
     "whether the pinhole's tangential distortion p1, p2 is fitted (candidate fitted) or held at the start's values "
     "(held), chosen by held-out folds on the first detection pass's corners: the usable views split into `folds` "
@@ -131,6 +138,7 @@ json ToJson(const CalibrationRecord& r) {
     out["base_profile"] = k->base_profile;
   }
   if (const auto& l = r.lens_choice) j["lens_choice"] = FoldChoiceJson(*l, kLensChoiceDefinition);
+  if (const auto& p = r.profile_choice) j["profile_choice"] = FoldChoiceJson(*p, kProfileChoiceDefinition);
   if (const auto& t = r.tangential_choice) j["tangential_choice"] = FoldChoiceJson(*t, kTangentialChoiceDefinition);
   if (const auto& h = r.holdout) {
     json& out = j["holdout"];
@@ -261,6 +269,8 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
       r.knot_choice->base_profile = k.at("base_profile").get<std::string>();
     }
     if (j.contains("lens_choice")) r.lens_choice = FoldChoiceFromJson<NamedChoice>(at("lens_choice"), name, "lens_choice");
+    if (j.contains("profile_choice"))
+      r.profile_choice = FoldChoiceFromJson<NamedChoice>(at("profile_choice"), name, "profile_choice");
     if (j.contains("tangential_choice"))
       r.tangential_choice = FoldChoiceFromJson<NamedChoice>(at("tangential_choice"), name, "tangential_choice");
     if (j.contains("holdout")) {

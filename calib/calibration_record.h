@@ -49,6 +49,8 @@ struct CalibrationRecord {
   std::optional<KnotChoice> knot_choice;  // when chosen (CalibrationOptions::knots = kChooseKnots)
   // When chosen (CalibrationOptions::lens = kChooseLens, or unset without a guess).
   std::optional<NamedChoice> lens_choice;
+  // When chosen (CalibrationOptions::profile = kChooseProfile, or unset without a guess).
+  std::optional<NamedChoice> profile_choice;
   // When chosen (CalibrationOptions::tangential = kChooseTangential, or unset without a
   // guess; a pinhole).
   std::optional<NamedChoice> tangential_choice;

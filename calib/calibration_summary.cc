@@ -73,6 +73,7 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
                     warp->warp.x_mm, warp->std_x_mm, warp->warp.y_mm, warp->std_y_mm);
   if (const auto& knots = record.knot_choice) AppendNamedChoice("knots", NamedKnotChoice(*knots), &out);
   if (const auto& lens = record.lens_choice) AppendNamedChoice("lens", *lens, &out);
+  if (const auto& profile = record.profile_choice) AppendNamedChoice("mirror family", *profile, &out);
   if (const auto& tangential = record.tangential_choice) AppendNamedChoice("tangential terms p1, p2", *tangential, &out);
   if (const auto& held = record.holdout)
     AppendFormatted(out, "held out: %zu views, %d corners: RMS %.4f px (training %.4f px, ratio %.2f)\n",

@@ -99,6 +99,13 @@ bool NamedChoice::AnyScored() const {
   return std::any_of(held_out_rms_px.begin(), held_out_rms_px.end(), [](double rms) { return std::isfinite(rms); });
 }
 
+std::optional<KnownScore> KnownScoreOf(const NamedChoice& choice, const std::string& name) {
+  const auto found = std::find(choice.candidates.begin(), choice.candidates.end(), name);
+  const size_t index = found - choice.candidates.begin();
+  if (found == choice.candidates.end() || index >= choice.held_out_rms_px.size()) return std::nullopt;
+  return KnownScore{choice.held_out_rms_px[index], choice.held_out_corners};
+}
+
 NamedChoice ChooseByHeldOutFolds(const std::vector<std::string>& names,
                                  const std::vector<std::optional<FoldCandidate>>& candidates, double tolerance,
                                  const CalibrationTarget& target, const DetectionSet& views, int threads,

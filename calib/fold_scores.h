@@ -66,6 +66,10 @@ struct KnownScore {
   int held_out_corners = 0;
 };
 
+// The score `choice` gave the candidate `name` (NaN where it failed), to pass on as known
+// where the same candidate is scored again on the same views; nothing where it has none.
+std::optional<KnownScore> KnownScoreOf(const NamedChoice& choice, const std::string& name);
+
 // The candidates given (one per name, the simplest first; an absent one scores NaN, one
 // with a `known` score takes it unfitted) scored by ScoreByHeldOutFolds, and the preferred
 // one within `tolerance` chosen.

@@ -41,8 +41,9 @@ std::optional<RimCircle> MedianRimCircle(const std::vector<RimCircle>& circles);
 // rim that put a realistic render's first fit's rim 7-12 px beyond the image's, and the
 // tags the rim cuts, fitted across a rim that was not there, were refused. Nothing when
 // under half the circle lies in the image (clear of the camera's reflection), or the
-// radius would move by over 10 % (a circle that is not this mirror's rim); then `why` (if
-// given) says which, in one line.
+// radius would shrink by over 10 % or grow by over 10 % (25 % for a mirror without
+// free-form terms, whose curvature continues past the corners): a circle that is not this
+// mirror's rim; then `why` (if given) says which, in one line.
 std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& rim, std::string* why = nullptr);
 
 }  // namespace omnical

@@ -148,6 +148,14 @@ TEST(CalibrateApi, RecordRoundTripsThroughCalibrationJson) {
   EXPECT_EQ(tangential_back.tangential_choice->chosen, "fitted");
   EXPECT_EQ(tangential_back.lens_choice->chosen, "orthographic");
   EXPECT_EQ(CalibrationJsonText(tangential_back), CalibrationJsonText(chosen));
+  // And a mirror family's.
+  chosen.profile_choice = NamedChoice{kProfileCandidates, {0.21, 0.20}, 384, 5, "even_asphere"};
+  const CalibrationRecord profile_back = ParseCalibrationJson(CalibrationJsonText(chosen), "memory");
+  ASSERT_TRUE(profile_back.profile_choice.has_value());
+  EXPECT_EQ(profile_back.profile_choice->chosen, "even_asphere");
+  EXPECT_EQ(profile_back.profile_choice->held_out_rms_px, (std::vector<double>{0.21, 0.20}));
+  EXPECT_EQ(profile_back.tangential_choice->chosen, "fitted");
+  EXPECT_EQ(CalibrationJsonText(profile_back), CalibrationJsonText(chosen));
   // Images no view was made of, with the reason.
   chosen.views_skipped = {{"a.png", "no tag of the target found"}, {"b.png", "cannot read the image"}};
   const CalibrationRecord skipped_back = ParseCalibrationJson(CalibrationJsonText(chosen), "memory");
@@ -368,7 +376,7 @@ TEST(CalibrateApi, ARimCircleNotTheFitsRimIsReported) {
       std::smatch radius;  // the mask's circle: 400 px, within the rim detector's few px
       ASSERT_TRUE(std::regex_search(w.text, radius, std::regex("radius ([0-9.]+) px"))) << w.text;
       EXPECT_NEAR(std::stod(radius[1]), 400.0, 3.0) << w.text;
-      EXPECT_NE(w.text.find("over 10 % apart"), std::string::npos) << w.text;
+      EXPECT_NE(w.text.find("over 10 % inside it"), std::string::npos) << w.text;
       EXPECT_NE(w.text.find("detection pass 2"), std::string::npos) << w.text;
     }
   EXPECT_EQ(reported, 1);

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "calib/bundle_fit.h"
+#include "calib/initial_sensor.h"
 #include "calib/rim_circle.h"
 #include "model/io/codecs/image_codecs.h"
 #include "test_sensors.h"
@@ -115,6 +116,35 @@ TEST(RimCircle, MovesASensorsRimOntoTheImages) {
   why.clear();
   EXPECT_FALSE(SensorWithImageRim(truth, beyond, &why));
   EXPECT_NE(why.find("lies in the image at under half its points"), std::string::npos) << why;
+}
+
+// A fit's rim only encloses its corners. Where no board reached the rim, the images' circle
+// lies beyond it: a conic (here the render's sphere) may follow it up to 25 % out, its
+// curvature continuing as the mirror's does; a mirror with free-form terms only 10 %, since
+// past its corners those terms are extrapolated (calib/profile_choice.h: a polynomial widened
+// 19 % lost its refit). Inwards 10 % for both: corners beyond a rim are no rim's.
+TEST(RimCircle, LetsAConicsRimGrowFurtherThanAFreeFormOnes) {
+  const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/realistic-aprilgrid";
+  const Sensor truth = LoadSensorYaml(set + "/sensor.yaml");
+  ASSERT_EQ(std::string(truth.profile_name()), "sphere");
+  const auto circle = DetectRimCircle(omnical::LoadImageFile(set + "/rim0.jpg", cv::IMREAD_GRAYSCALE));
+  ASSERT_TRUE(circle);
+  const Sensor free_form = ConvertProfile(truth, "polynomial");
+  for (const double growth : {1.15, 1.2}) {
+    const Sensor conic_inside = SensorWithWiderRim(truth, 1.0 / growth);
+    const auto moved = SensorWithImageRim(conic_inside, *circle);
+    ASSERT_TRUE(moved) << growth;
+    EXPECT_NEAR(moved->rim_radius_mm(), truth.rim_radius_mm(), 0.1) << growth;
+    std::string why;
+    EXPECT_FALSE(SensorWithImageRim(SensorWithWiderRim(free_form, 1.0 / growth), *circle, &why)) << growth;
+    EXPECT_NE(why.find("over 10 % beyond it (free-form terms"), std::string::npos) << why;
+  }
+  std::string why;  // 28 %: beyond a conic's 25 %
+  EXPECT_FALSE(SensorWithImageRim(SensorWithWiderRim(truth, 1.0 / 1.28), *circle, &why));
+  EXPECT_NE(why.find("over 25 % beyond it"), std::string::npos) << why;
+  why.clear();  // inwards: 10 % for a conic too
+  EXPECT_FALSE(SensorWithImageRim(SensorWithWiderRim(truth, 1.15), *circle, &why));
+  EXPECT_NE(why.find("over 10 % inside it"), std::string::npos) << why;
 }
 
 }  // namespace

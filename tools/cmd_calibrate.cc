@@ -93,9 +93,10 @@ Command CalibrateCommand() {
                            "rim circle in the images (the lens chosen by held-out folds; see --lens)");
             sub.add_option("--profile", library.profile,
                            "Mirror family to fit: " + JoinChoices(ProfileNames(false)) +
-                               " (polynomial by default without a guess; a hyperboloid needs --sensor); a guess of "
-                               "another family is converted")
-                ->check(CLI::IsMember(ProfileNames(false)));
+                               " (a hyperboloid needs --sensor; a guess of another family is converted), or auto (the "
+                               "default without a guess, with >= 4 usable views): the polynomial or the even asphere by "
+                               "held-out folds, as --lens auto")
+                ->check(CLI::IsMember([] { auto names = ProfileNames(false); return names.push_back(kChooseProfile), names; }()));
             sub.add_option("--rim-field-deg", library.rim_field_deg,
                            "Without a guess: the rim ray's angle from the mirror axis (Omega, deg) to start from")
                 ->check(CLI::Range(10.0, 170.0))->capture_default_str();
@@ -110,7 +111,7 @@ Command CalibrateCommand() {
             sub.add_option("--detection-passes", library.detection_passes,
                            "With --images: pass 2 re-detects aprilgrid corners (checkerboards: refines them, searches "
                            "boardless images) through the first fit and fits again; pass 3 through the second (checkerboards: "
-                           "only if it finds more boards); 1: a single pass, checkerboard corners left as found")
+                           "only if it finds more boards; one more after boards the last found); 1: a single pass")
                 ->check(CLI::Range(1, 5))->capture_default_str();
             sub.add_option("--tolerance", options->tolerance,
                            "Design tolerances (one std) as weak priors, name=value,...: e.g. m_mm=2,decenter_mm=1,"

@@ -274,6 +274,13 @@ def test_load_calibration_round_trip(runs, tmp_path):
     tangential = omnical.load_calibration(tmp_path / "tangential.json").tangential_choice
     assert tangential["chosen"] == "fitted" and tangential["held_out_rms_px"] == [0.31, 0.30]
     assert record.tangential_choice is None
+    # And the mirror family's (--profile auto, the default without a guess).
+    data["profile_choice"] = {"candidates": ["polynomial", "even_asphere"], "held_out_rms_px": [0.21, 0.20],
+                              "held_out_corners": 384, "folds": 5, "chosen": "even_asphere"}
+    (tmp_path / "profile.json").write_text(json.dumps(data))
+    profile = omnical.load_calibration(tmp_path / "profile.json").profile_choice
+    assert profile["chosen"] == "even_asphere" and profile["held_out_rms_px"] == [0.21, 0.20]
+    assert record.profile_choice is None
 
 
 def test_calibrate_from_detections_without_guess_with_leave_one_out(runs, tmp_path):
@@ -369,6 +376,12 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
     with pytest.raises(omnical.InputError) as raised:
         omnical.calibrate(TARGET, detections=detections, guess=GUESS, holdout=40)
     assert str(raised.value) == few_views and "holdout: 40 views held out" in few_views
+    # profile='auto' chooses an unknown mirror's family: refused with a guess, in both front ends.
+    auto_with_guess = cli_error(run_cli("calibrate", "--target", TARGET, "--detections", detections, "--sensor", GUESS,
+                                        "--profile", "auto", "--out", tmp_path / "bad"))
+    with pytest.raises(omnical.InputError) as raised:
+        omnical.calibrate(TARGET, detections=detections, guess=GUESS, profile="auto")
+    assert str(raised.value) == auto_with_guess and "profile: auto chooses an unknown mirror's family" in auto_with_guess
     with pytest.raises(omnical.InputError, match="distance_mm: the object distance must be > 0"):
         omnical.diff(result.sensor, result.sensor, distance_mm=0)
     with pytest.raises(omnical.InputError, match="field: expected"):

@@ -186,7 +186,7 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
   field("robust_loss_px", &CalibrationRecord::robust_loss_px, "The robust loss scale used (px; 0: least squares).");
   field("covariance_ok", &CalibrationRecord::covariance_ok, "Whether the covariance could be computed.");
   field("start", &CalibrationRecord::start, "Where the fit started: the guess (its file) or the rim circle.");
-  field("detection_passes", &CalibrationRecord::detection_passes, "Detection passes made (2: re-detected through the first fit; 3: through the second).");
+  field("detection_passes", &CalibrationRecord::detection_passes, "Detection passes made (2: re-detected through the first fit; 3: through the second, or after boards pass 2 found).");
   field("nearest_target_mm", &CalibrationRecord::nearest_target_mm, "Distance of the nearest fitted board from the lens (mm).");
   field("farthest_target_mm", &CalibrationRecord::farthest_target_mm, "Distance of the farthest fitted board (mm).");
   field("views_left_out", &CalibrationRecord::views_left_out, "dict image -> why it was left out of the fit.");
@@ -268,6 +268,10 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
       "lens_choice", [record, named_choice](const Holder& holder) { return named_choice(record(holder).lens_choice); },
       "Without a guess, the lens chosen by held-out folds (lens='auto', the default): dict candidates, held_out_rms_px (per "
       "candidate, NaN where it failed), held_out_corners, folds, chosen; None unless chosen.");
+  cls.def_property_readonly(
+      "profile_choice", [record, named_choice](const Holder& holder) { return named_choice(record(holder).profile_choice); },
+      "Without a guess, the mirror family chosen by held-out folds (profile='auto', the default): dict candidates "
+      "(polynomial, even_asphere), held_out_rms_px, held_out_corners, folds, chosen; None unless chosen.");
   cls.def_property_readonly(
       "tangential_choice",
       [record, named_choice](const Holder& holder) { return named_choice(record(holder).tangential_choice); },
@@ -734,10 +738,13 @@ design tolerances, as --sensor); without one the fit starts from the mirror's ri
 views), 'orthographic' or 'pinhole'). tangential: a pinhole's p1, p2, 'off' (held; '' with
 a guess), 'on' (fitted) or 'auto' ('' without a guess: fitted where that predicts held-out
 folds better, result.tangential_choice). profile: mirror family to fit
-(one of omnical.PROFILES but tabulated; '' the guess's). fixed: blocks held (lens,
+(one of omnical.PROFILES but tabulated; '' the guess's; without a guess 'auto', '' too:
+the polynomial or the even asphere by held-out folds, result.profile_choice; the
+polynomial with under 4 views). fixed: blocks held (lens,
 lens_scale, principal_point, distortion, tangential, m, tilt, decenter, shape, poses; a list or 'a,b').
 loss_px: Huber scale (0: least squares). detection_passes: 2 re-detects through the
-first fit, 3 (aprilgrids) once more through the second. threads: detection, board checks and the fit's Jacobians, 0 for all cores
+first fit, 3 (aprilgrids) once more through the second (checkerboards: one pass more
+after boards the last found; result.detection_passes counts them). threads: detection, board checks and the fit's Jacobians, 0 for all cores
 (the same result for any count). leave_one_out: also fit without each view.
 tolerances: design tolerances (dict name -> one std, or 'name=value,...').
 distances_mm / distances_n: where to predict the projection error (mm, or rim radii);

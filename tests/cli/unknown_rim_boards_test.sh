@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# Boards by the rim of an unknown mirror, from the images alone with no option but the
+# target: datasets-synthetic/rendered/realistic-checkerboard (a sphere behind a pinhole;
+# bent paper boards, blur, noise, colour JPEG 85; two boards by the rim, rim0 and rim1, and
+# real007 beyond the other boards' reach). The first detection pass misses those three; the
+# second finds them only through a first fit that extrapolates to the images' rim circle.
+# The mirror family is chosen by held-out folds (calib/profile_choice.h): the even asphere
+# (a conic) predicts the held-out views at 0.202 px against the polynomial's 0.210
+# (measured 2026-11-30); its first fit puts the rim circle 10.1 % beyond its corners, which
+# a conic may follow (calib/rim_circle.h), and all 12 views are used. The boards pass 2
+# finds were refined through a fit that had not seen them, so a third pass follows: all
+# 570 corners the truth sees used (553 without it, the rim boards' corners bending the fit
+# into the dolly-zoom valley, 0.069 / 0.31 px from the truth at 300 mm / 2 m), RMS 0.040
+# px, the warp 2.985 / 0.973 mm, and 0.013 / 0.030 px from the true sensor at 300 mm / 2 m
+# after the best rigid alignment over the detected field. Before (the polynomial alone): 9
+# views, 418 corners, rim0, rim1 and real007 skipped, 0.116 / 0.140 px from the truth over
+# its narrower field; widened to the circle anyway, the polynomial's refit fell to 6.2 px.
+# Bounds: every view used and none skipped, 99 % of the visible corners (the issue's),
+# 0.05 / 0.1 px from the truth (4 / 3 x the measured: a fit missing the third pass fails
+# both), the even asphere chosen on a margin over 1 % (the choice rule's).
+# Usage: unknown_rim_boards_test.sh OMNICAL_BINARY SOURCE_DIR
+set -u
+omnical=$1
+source_dir=$(cd "$2" && pwd)
+data=$source_dir/datasets-synthetic
+source "$source_dir/tests/cli/harness.sh"
+set_dir=$data/rendered/realistic-checkerboard
+
+"$omnical" -q calibrate --target "$data/targets/checkerboard-8x6-30mm.yaml" --images "$set_dir" --threads 2 \
+  --out "$work/cal" 2>/dev/null || { echo "FAIL: calibrate exited $?"; exit 1; }
+for mm in 300 2000; do
+  "$omnical" -q diff "$set_dir/sensor.yaml" "$work/cal" --distance-mm $mm --field "$work/cal/detections.json" \
+    --out "$work/diff_$mm" >/dev/null || fail "diff at $mm mm exited $?"
+done
+python3 - "$work" "$set_dir" <<'PY' && pass || fail "rim boards of an unknown mirror from the images alone"
+import glob, json, sys
+work, set_dir = sys.argv[1:3]
+cal = json.load(open(work + "/cal/calibration.json"))
+diff = {mm: json.load(open("%s/diff_%d/diff.json" % (work, mm))) for mm in (300, 2000)}
+profile = cal["profile_choice"]
+polynomial, conic = profile["held_out_rms_px"]
+print("held out: polynomial %.4f, even asphere %.4f px; chosen %s" % (polynomial, conic, profile["chosen"]))
+assert profile["chosen"] == "even_asphere" and conic < 0.99 * polynomial, profile
+assert "profile: even_asphere" in open(work + "/cal/sensor.yaml").read()
+visible = sum(sum(1 for c in json.load(open(f))["targets"][0]["corners"] if c["visible"])
+              for f in glob.glob(set_dir + "/*.json") if "targets" in json.load(open(f)))
+used = cal["observations"] - cal["outliers"]
+print("views %d, corners used %d of %d visible; RMS %.4f px; from the truth %.4f / %.4f px at 300 / 2000 mm" % (
+    len(cal["poses"]), used, visible, cal["rms_px"], diff[300]["diff_rms_px"], diff[2000]["diff_rms_px"]))
+assert len(cal["poses"]) == 12 and "views_skipped" not in cal and "views_left_out" not in cal, (
+    len(cal["poses"]), cal.get("views_skipped"), cal.get("views_left_out"))
+assert not any("fit's own rim" in w for w in cal.get("warnings", [])), cal["warnings"]
+assert cal["detection_passes"] == 3, cal["detection_passes"]
+assert used >= 0.99 * visible, (used, visible)
+assert diff[300]["aligned"] and diff[300]["diff_rms_px"] < 0.05 and diff[2000]["diff_rms_px"] < 0.1, diff
+PY
+summary unknown_rim_boards_test
