@@ -347,10 +347,9 @@ bool HoldsTangential(const std::set<std::string>& fixed) {
 }  // namespace
 
 std::string CalibrationOptions::Check() const {
-  const std::vector<std::string> profiles = ProfileNames(false);
-  if (!profile.empty() && profile != kChooseProfile &&
-      std::find(profiles.begin(), profiles.end(), profile) == profiles.end())
-    return "profile: unknown mirror family '" + profile + "' (" + JoinChoices(profiles) + ", or auto)";
+  const std::vector<std::string> profiles = CalibrationProfileNames();
+  if (!profile.empty() && std::find(profiles.begin(), profiles.end(), profile) == profiles.end())
+    return "profile: unknown mirror family '" + profile + "' (" + JoinChoices(profiles) + ")";
   if (!(rim_field_deg >= 10.0 && rim_field_deg <= 170.0)) return "rim_field_deg: must lie in 10-170 deg";
   if (!lens.empty() && lens != "orthographic" && lens != "pinhole" && lens != kChooseLens)
     return "lens: the rim circle starts an orthographic or a pinhole lens, or 'auto' (got '" + lens + "')";
@@ -475,7 +474,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
                                                                 "): lens chooses the rim circle's start, without a guess"));
   if (input.guess && options.profile == kChooseProfile)
     throw InputError(InputMessage(input.guess_name, "profile",
-                                  "auto chooses an unknown mirror's family, without a guess (the guess is a " +
+                                  "auto chooses an unknown mirror's family, without a guess (the guess's is " +
                                       std::string(input.guess->profile_name()) + "; give a family to convert it to)"));
   // Without a guess the lens, and a pinhole's p1, p2, are chosen by held-out folds unless
   // asked for: the rim circle cannot tell a telecentric lens from a perspective camera, and
@@ -545,8 +544,8 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   // The starting sensor: the guess (in another profile family if asked), or, with no
   // guess, the rim circle of the images through a lens and a mirror family (each's, to
   // choose one; the lens is chosen through the first family).
-  const bool profile_chosen = !input.guess && (options.profile.empty() || options.profile == kChooseProfile);
-  const std::string rim_profile = profile_chosen ? kProfileCandidates[0] : options.profile;
+  const bool profile_unset_or_auto = !input.guess && (options.profile.empty() || options.profile == kChooseProfile);
+  const std::string rim_profile = profile_unset_or_auto ? kProfileCandidates[0] : options.profile;
   const auto rim_start = [&](const std::string& lens, const std::string& profile) {
     const Sensor start = SensorFromRimCircle(*rim, detections.image_width_px, detections.image_height_px, profile,
                                              options.rim_field_deg, lens);
@@ -556,13 +555,13 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   // none (scored NaN) where it cannot start (a rim ray it cannot reach, a tolerance on a
   // parameter it lacks) or pose every view.
   const auto rim_candidate = [&](const std::string& lens, const std::string& profile, const DetectionSet& views,
-                                 std::vector<CalibrationWarning>* said) -> std::optional<FoldCandidate> {
+                                 std::vector<CalibrationWarning>* warnings_out) -> std::optional<FoldCandidate> {
     try {
       Sensor start = rim_start(lens, profile);
       std::vector<TargetPose> poses(views.images.size());
       for (size_t v = 0; v < poses.size(); ++v)
         if (!InitialTargetPose(start, input.target, views.images[v], &poses[v])) return std::nullopt;
-      FitOptions start_options = FitOptionsFor(input, options, start, said);
+      FitOptions start_options = FitOptionsFor(input, options, start, warnings_out);
       return FoldCandidate{std::move(start), std::move(start_options), std::move(poses)};
     } catch (const InputError&) {
       return std::nullopt;
@@ -674,8 +673,13 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
       fit_options = profile.options;
       views.poses = profile.initial_poses;
     }
-    profile_said = choice.chosen + " mirror" + (choice.AnyScored() ? " (chosen by held-out folds)" : "");
+    const bool scored = choice.AnyScored();
+    profile_said = choice.chosen + " mirror" + (scored ? " (chosen by held-out folds)" : "");
     record.start = "rim circle, " + profile_said + ", " + lens_said;
+    if (!scored)
+      warnings.push_back({WarningCode::kProfileNotChosen, "profile",
+                          "neither mirror family could be fitted to every held-out fold of the views (a view where "
+                          "no other reaches, or no valid sensor?); the " + choice.chosen + " is kept"});
   }
   // A pinhole's tangential terms by held-out folds, from the start the lens and mirror
   // choices left (calib/tangential_choice.h). Held, that start is the last choice's chosen
@@ -783,8 +787,8 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   // tests/bench/realistic_seeds.py), for a pass's time. Checkerboards: the images where none was found
   // are searched again through the fit's virtual views (calib/detect.h), and every
   // corner, found unrefined, is refined in patches through the fit (on grid steps of 20 px
-  // and more, calib/refine_corners.h); a pass after the second only if it finds more
-  // boards. Through the design guess instead, the realistic checkerboard render's fx, k2
+  // and more, calib/refine_corners.h); a pass after the second only if it or the one
+  // before finds more boards. Through the design guess instead, the realistic checkerboard render's fx, k2
   // and decenter_x came out 3.2-4.8 std off (through the first fit: all within 2.2 std).
   const bool checkerboard = input.target.type() == CalibrationTarget::Type::kCheckerboard;
   DetectionSet found = detections;  // checkerboards: the corners as found, not yet refined
@@ -795,7 +799,8 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     // Detected through the previous fit with its rim where the images show it
     // (calib/rim_circle.h): the tags and junctions the rim cuts are fitted across it.
     std::string rim_refused;
-    std::optional<Sensor> through = rim ? SensorWithImageRim(*fit.sensor, *rim, &rim_refused) : std::nullopt;
+    std::optional<Sensor> through =
+        rim ? SensorWithImageRim(*fit.sensor, *rim, &rim_refused, /*rim_from_corners=*/!input.guess) : std::nullopt;
     if (!through) through = *fit.sensor;
     const bool boards_found = checkerboard && FindMissedCheckerboards(input, options, *through, &found);
     if (checkerboard && !boards_found && !boards_found_before && pass > 2) break;

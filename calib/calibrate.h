@@ -74,8 +74,8 @@ struct CalibrationOptions {
   double loss_px = 1.0;
   int max_iterations = 200;
   // From images: 2 re-detects through the first fit, 3 through the second (checkerboards:
-  // only where it finds more boards). Boards a checkerboard's last pass found get one pass
-  // more (record.detection_passes counts the passes run).
+  // only where it or the one before finds more boards). Boards a checkerboard's last pass
+  // found get one pass more (record.detection_passes counts the passes run).
   int detection_passes = 2;
   int threads = 1;  // detection, the board-size checks and the fit's Jacobians (the same result for any count)
   bool leave_one_out = false;

@@ -26,6 +26,7 @@ const char* WarningCodeName(WarningCode code) {
     case WarningCode::kTangentialNotFitted: return "tangential_not_fitted";
     case WarningCode::kBoardScreenStopped: return "board_screen_stopped";
     case WarningCode::kImageRimNotUsed: return "image_rim_not_used";
+    case WarningCode::kProfileNotChosen: return "profile_not_chosen";
   }
   return "unknown";
 }

@@ -29,6 +29,7 @@ enum class WarningCode {
   kTangentialNotFitted,       // subject: tangential; asked for (on/auto, not by default) but not fitted: an orthographic lens chosen, or no candidate scored
   kBoardScreenStopped,        // the board-size screen would refuse more than a quarter of the views: it kept them
   kImageRimNotUsed,           // subject: rim_circle; the images' rim is not this fit's mirror rim: detection kept the fit's
+  kProfileNotChosen,          // subject: profile; neither family predicted every held-out fold, the polynomial kept
 };
 
 // A stable lower-case name for programs (Python's CalibrationWarning.code), e.g.

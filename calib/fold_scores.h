@@ -4,9 +4,9 @@
 // rest and the held-out views' poses fitted with its sensor held (EvaluateHeldOutViews).
 // The score is the RMS over every held-out corner of every fold, per corner
 // sqrt(mean |e|^2). Used to choose a spline's knot count (calib/knot_choice.h), the lens
-// of an unknown mirror (calib/lens_choice.h) and whether a pinhole's tangential terms are
-// fitted (calib/tangential_choice.h), never by training RMS, which only falls as
-// parameters are added.
+// and the mirror family of an unknown mirror (calib/lens_choice.h, calib/profile_choice.h)
+// and whether a pinhole's tangential terms are fitted (calib/tangential_choice.h), never
+// by training RMS, which only falls as parameters are added.
 #pragma once
 
 #include <optional>

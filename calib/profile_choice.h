@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "model/model_registry.h"
+
 namespace omnical {
 
 // CalibrationOptions::profile: choose here (without a guess).
@@ -22,5 +24,12 @@ inline constexpr const char* kChooseProfile = "auto";
 // 0.6 % and the polynomial stays.
 inline const std::vector<std::string> kProfileCandidates = {"polynomial", "even_asphere"};
 constexpr double kProfileScoreTolerance = 0.01;
+
+// What CalibrationOptions::profile accepts: the families the fit can shape, or kChooseProfile.
+inline std::vector<std::string> CalibrationProfileNames() {
+  std::vector<std::string> names = ProfileNames(false);
+  names.push_back(kChooseProfile);
+  return names;
+}
 
 }  // namespace omnical

@@ -176,24 +176,28 @@ std::optional<RimCircle> MedianRimCircle(const std::vector<RimCircle>& circles) 
   return out;
 }
 
-std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& rim, std::string* why) {
+std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& rim, std::string* why,
+                                         bool rim_from_corners) {
   constexpr int kCirclePoints = 360;
   // Seen: 1-5.4 % (a first fit's rim 7-12 px off). Near the rim a mirror's image changes
   // little with its radius, so a few px there are several % in mm; 5 % refused the 5.4 %
   // of realistic checkerboard seed 6 and lost 4 rim junctions.
   constexpr double kMaxRimChangeRatio = 0.10;
-  // Outwards a conic may grow further: a fit's rim only encloses its corners, and where no
-  // board reached the rim the images' circle lies beyond them. A conic's curvature
-  // continues there as the mirror's does (the realistic checkerboard render from the images
-  // alone: the even asphere's first fit put the circle 10.06 % out; widened, its 3 rim
-  // boards were found and the fit ended 0.072 px from the true sensor at 300 mm). Free-form
-  // terms are extrapolated there, not measured: the polynomial put the same circle 19 % out,
-  // and through it the rim boards drove the refit to a 6 px RMS (calib/profile_choice.h).
+  // Outwards a conic whose rim is its corners' may grow further: where no board reached the
+  // rim the images' circle lies beyond them, and a conic's curvature continues there as the
+  // mirror's does (the realistic checkerboard render from the images alone: the even
+  // asphere's first fit put the circle 10.06 % out; widened, its 3 rim boards were found and
+  // the calibration ended 0.013 px from the true sensor at 300 mm). Free-form terms are
+  // extrapolated there, not measured: the polynomial put the same circle 19 % out, and
+  // through it the rim boards drove the refit to a 6 px RMS (calib/profile_choice.h). A
+  // design's rim is the mirror's: a circle far beyond it is some other ring.
   constexpr double kMaxConicRimGrowthRatio = 0.25;
   const bool free_form = std::visit([](const auto& model) { return HasFreeFormTerms(model.mirror); }, sensor.model());
-  const double max_growth = free_form ? kMaxRimChangeRatio : kMaxConicRimGrowthRatio;
-  // Wide enough that a circle beyond the sensor's rim still meets the mirror.
-  const Sensor wide = SensorWithWiderRim(sensor, 1.0 + 3.0 * kMaxRimChangeRatio);
+  const bool conic_growth = rim_from_corners && !free_form;
+  const double max_growth = conic_growth ? kMaxConicRimGrowthRatio : kMaxRimChangeRatio;
+  // Wide enough that a circle beyond the largest growth allowed still meets the mirror (and
+  // is measured, not counted as beyond it).
+  const Sensor wide = SensorWithWiderRim(sensor, 1.0 + kMaxConicRimGrowthRatio + 0.05);
   std::vector<double> radii_mm;
   for (int k = 0; k < kCirclePoints; ++k) {
     const double angle = 2.0 * M_PI * k / kCirclePoints;
@@ -222,9 +226,10 @@ std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& 
         std::snprintf(text, sizeof text,
                       "%s is a mirror radius of %.2f mm through the fit, whose rim is %.2f mm: over %.0f %% %s", circle,
                       rim_mm, sensor.rim_radius_mm(), 100.0 * (change < 0.0 ? kMaxRimChangeRatio : max_growth),
-                      change < 0.0 ? "inside it"
-                      : free_form  ? "beyond it (free-form terms only extrapolate there)"
-                                   : "beyond it");
+                      change < 0.0         ? "inside it"
+                      : conic_growth       ? "beyond it"
+                      : rim_from_corners   ? "beyond it (free-form terms only extrapolate there)"
+                                           : "beyond the design's rim");
       else
         std::snprintf(text, sizeof text, "%s lies mostly beyond the fit's mirror (rim %.2f mm)", circle, sensor.rim_radius_mm());
       *why = text;

@@ -41,9 +41,12 @@ std::optional<RimCircle> MedianRimCircle(const std::vector<RimCircle>& circles);
 // rim that put a realistic render's first fit's rim 7-12 px beyond the image's, and the
 // tags the rim cuts, fitted across a rim that was not there, were refused. Nothing when
 // under half the circle lies in the image (clear of the camera's reflection), or the
-// radius would shrink by over 10 % or grow by over 10 % (25 % for a mirror without
-// free-form terms, whose curvature continues past the corners): a circle that is not this
-// mirror's rim; then `why` (if given) says which, in one line.
-std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& rim, std::string* why = nullptr);
+// radius would shrink by over 10 % or grow by over 10 %: a circle that is not this mirror's
+// rim; then `why` (if given) says which, in one line. `rim_from_corners`: the sensor's rim
+// is only its farthest corner's (a fit without a design, whose boards may not reach the
+// rim); then a mirror without free-form terms may grow by up to 25 %, its curvature
+// continuing past the corners as a conic mirror's does.
+std::optional<Sensor> SensorWithImageRim(const Sensor& sensor, const RimCircle& rim, std::string* why = nullptr,
+                                         bool rim_from_corners = false);
 
 }  // namespace omnical

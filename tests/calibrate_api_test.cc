@@ -382,11 +382,12 @@ TEST(CalibrateApi, ARimCircleNotTheFitsRimIsReported) {
   EXPECT_EQ(reported, 1);
 }
 
-// Without a guess the lens and a pinhole's p1, p2 are chosen by held-out folds unless
-// asked for (CalibrationOptions::lens and tangential, ""): the choice is recorded, the
-// sensor has the lens chosen, p1, p2 are scored only through a chosen pinhole, and the
-// default says nothing where they do not apply. With fewer views than folds need, the
-// default keeps the orthographic lens quietly, where an explicit "auto" is refused.
+// Without a guess the lens, the mirror family and a pinhole's p1, p2 are chosen by held-out
+// folds unless asked for (CalibrationOptions::lens, profile and tangential, ""): the
+// choice is recorded, the sensor has the lens and family chosen, p1, p2 are scored only
+// through a chosen pinhole, and the default says nothing where they do not apply. With
+// fewer views than folds need, the default keeps the orthographic lens and the polynomial
+// quietly, where an explicit "auto" is refused.
 TEST(CalibrateApi, WithoutAGuessTheLensIsChosenWhereTheViewsAllowFolds) {
   CalibrationInput input = InputFromTruth();
   input.guess.reset();
@@ -403,20 +404,38 @@ TEST(CalibrateApi, WithoutAGuessTheLensIsChosenWhereTheViewsAllowFolds) {
   EXPECT_NE(chosen.record.start.find(lens.chosen + " lens (chosen by held-out folds)"), std::string::npos)
       << chosen.record.start;
   EXPECT_EQ(chosen.record.tangential_choice.has_value(), lens.chosen == "pinhole");
+  ASSERT_TRUE(chosen.record.profile_choice.has_value());
+  const NamedChoice& profile = *chosen.record.profile_choice;
+  EXPECT_EQ(profile.candidates, kProfileCandidates);
+  EXPECT_EQ(profile.folds, lens.folds);
+  EXPECT_TRUE(profile.AnyScored());
+  EXPECT_EQ(profile.chosen, chosen.sensor.profile_name());
+  // The family is chosen through the lens chosen, whose score it reuses for the polynomial.
+  const size_t chosen_lens =
+      std::find(lens.candidates.begin(), lens.candidates.end(), lens.chosen) - lens.candidates.begin();
+  EXPECT_EQ(profile.held_out_rms_px[0], lens.held_out_rms_px[chosen_lens]);
+  EXPECT_NE(chosen.record.start.find(profile.chosen + " mirror (chosen by held-out folds)"), std::string::npos)
+      << chosen.record.start;
   for (const CalibrationWarning& w : chosen.warnings) {
     EXPECT_NE(w.code, WarningCode::kTangentialNotFitted) << w.text;
     EXPECT_NE(w.code, WarningCode::kLensNotChosen) << w.text;
+    EXPECT_NE(w.code, WarningCode::kProfileNotChosen) << w.text;
   }
 
   input.detections->images.resize(3);
   const CalibrationResult few = Calibrate(input, options);
   EXPECT_FALSE(few.record.lens_choice.has_value());
   EXPECT_FALSE(few.record.tangential_choice.has_value());
+  EXPECT_FALSE(few.record.profile_choice.has_value());
+  EXPECT_STREQ(few.sensor.profile_name(), "polynomial");
   EXPECT_STREQ(few.sensor.lens_name(), "orthographic");
   EXPECT_EQ(few.record.start, "rim circle, polynomial mirror, orthographic lens");
   options.tangential = kTangentialOn;  // p1, p2 asked for where the lens cannot be chosen: refused, not dropped
   ExpectRefused(input, options, "tangential: the lens is chosen by held-out folds, which need >= 4 usable views");
   options.tangential.clear();
+  options.profile = kChooseProfile;
+  ExpectRefused(input, options, "profile: choosing by held-out folds needs >= 4 usable views");
+  options.profile.clear();
   options.lens = kChooseLens;
   ExpectRefused(input, options, "lens: choosing by held-out folds needs >= 4 usable views");
 }

@@ -118,11 +118,12 @@ TEST(RimCircle, MovesASensorsRimOntoTheImages) {
   EXPECT_NE(why.find("lies in the image at under half its points"), std::string::npos) << why;
 }
 
-// A fit's rim only encloses its corners. Where no board reached the rim, the images' circle
-// lies beyond it: a conic (here the render's sphere) may follow it up to 25 % out, its
-// curvature continuing as the mirror's does; a mirror with free-form terms only 10 %, since
-// past its corners those terms are extrapolated (calib/profile_choice.h: a polynomial widened
-// 19 % lost its refit). Inwards 10 % for both: corners beyond a rim are no rim's.
+// A fit without a design has a rim that only encloses its corners. Where no board reached
+// the rim, the images' circle lies beyond it: a conic (here the render's sphere) may follow
+// it up to 25 % out, its curvature continuing as the mirror's does; a mirror with free-form
+// terms only 10 %, since past its corners those terms are extrapolated
+// (calib/profile_choice.h: a polynomial widened 19 % lost its refit). A design's rim is the
+// mirror's: 10 % for any. Inwards 10 % for all: corners beyond a rim are no rim's.
 TEST(RimCircle, LetsAConicsRimGrowFurtherThanAFreeFormOnes) {
   const std::string set = testing::SourceDir() + "/datasets-synthetic/rendered/realistic-aprilgrid";
   const Sensor truth = LoadSensorYaml(set + "/sensor.yaml");
@@ -132,18 +133,21 @@ TEST(RimCircle, LetsAConicsRimGrowFurtherThanAFreeFormOnes) {
   const Sensor free_form = ConvertProfile(truth, "polynomial");
   for (const double growth : {1.15, 1.2}) {
     const Sensor conic_inside = SensorWithWiderRim(truth, 1.0 / growth);
-    const auto moved = SensorWithImageRim(conic_inside, *circle);
+    const auto moved = SensorWithImageRim(conic_inside, *circle, nullptr, /*rim_from_corners=*/true);
     ASSERT_TRUE(moved) << growth;
     EXPECT_NEAR(moved->rim_radius_mm(), truth.rim_radius_mm(), 0.1) << growth;
     std::string why;
-    EXPECT_FALSE(SensorWithImageRim(SensorWithWiderRim(free_form, 1.0 / growth), *circle, &why)) << growth;
+    EXPECT_FALSE(SensorWithImageRim(SensorWithWiderRim(free_form, 1.0 / growth), *circle, &why, true)) << growth;
     EXPECT_NE(why.find("over 10 % beyond it (free-form terms"), std::string::npos) << why;
+    why.clear();  // the same conic as a design: its rim is the mirror's
+    EXPECT_FALSE(SensorWithImageRim(conic_inside, *circle, &why)) << growth;
+    EXPECT_NE(why.find("over 10 % beyond the design's rim"), std::string::npos) << why;
   }
   std::string why;  // 28 %: beyond a conic's 25 %
-  EXPECT_FALSE(SensorWithImageRim(SensorWithWiderRim(truth, 1.0 / 1.28), *circle, &why));
+  EXPECT_FALSE(SensorWithImageRim(SensorWithWiderRim(truth, 1.0 / 1.28), *circle, &why, true));
   EXPECT_NE(why.find("over 25 % beyond it"), std::string::npos) << why;
   why.clear();  // inwards: 10 % for a conic too
-  EXPECT_FALSE(SensorWithImageRim(SensorWithWiderRim(truth, 1.15), *circle, &why));
+  EXPECT_FALSE(SensorWithImageRim(SensorWithWiderRim(truth, 1.15), *circle, &why, true));
   EXPECT_NE(why.find("over 10 % inside it"), std::string::npos) << why;
 }
 

@@ -96,7 +96,7 @@ Command CalibrateCommand() {
                                " (a hyperboloid needs --sensor; a guess of another family is converted), or auto (the "
                                "default without a guess, with >= 4 usable views): the polynomial or the even asphere by "
                                "held-out folds, as --lens auto")
-                ->check(CLI::IsMember([] { auto names = ProfileNames(false); return names.push_back(kChooseProfile), names; }()));
+                ->check(CLI::IsMember(CalibrationProfileNames()));
             sub.add_option("--rim-field-deg", library.rim_field_deg,
                            "Without a guess: the rim ray's angle from the mirror axis (Omega, deg) to start from")
                 ->check(CLI::Range(10.0, 170.0))->capture_default_str();
@@ -111,7 +111,7 @@ Command CalibrateCommand() {
             sub.add_option("--detection-passes", library.detection_passes,
                            "With --images: pass 2 re-detects aprilgrid corners (checkerboards: refines them, searches "
                            "boardless images) through the first fit and fits again; pass 3 through the second (checkerboards: "
-                           "only if it finds more boards; one more after boards the last found); 1: a single pass")
+                           "only if it or pass 2 finds boards; one more after boards the last found); 1: a single pass")
                 ->check(CLI::Range(1, 5))->capture_default_str();
             sub.add_option("--tolerance", options->tolerance,
                            "Design tolerances (one std) as weak priors, name=value,...: e.g. m_mm=2,decenter_mm=1,"

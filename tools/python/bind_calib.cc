@@ -574,8 +574,8 @@ void BindDetections(py::module_& m) {
           "code", [](const CalibrationWarning& w) { return WarningCodeName(w.code); },
           "What kind: image_unreadable, image_size_differs, checkerboard_refused, view_skipped, tolerance_not_applicable, "
           "view_left_out, sensor_invalid, not_converged, free_gauge, weakly_determined, one_distance, tolerance_conflict, "
-          "tolerance_note, predicted_error_unknown, predicted_error_high, held_out_worse, knot_count_replaced, lens_not_chosen, tangential_not_fitted, "
-          "board_screen_stopped, image_rim_not_used.")
+          "tolerance_note, predicted_error_unknown, predicted_error_high, held_out_worse, knot_count_replaced, "
+          "lens_not_chosen, tangential_not_fitted, board_screen_stopped, image_rim_not_used, profile_not_chosen.")
       .def_readonly("subject", &CalibrationWarning::subject, "The image or parameter it concerns ('' for the whole run).")
       .def_readonly("text", &CalibrationWarning::text, "The one-line message (what the CLI prints).")
       .def("__repr__", [](const CalibrationWarning& w) { return "<omnical.CalibrationWarning " + std::string(WarningCodeName(w.code)) + ": " + w.text + ">"; });
