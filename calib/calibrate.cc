@@ -1021,7 +1021,8 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
       }
       distance_labels.push_back(label);
       record.predicted_error.push_back({map.distance_mm, infinite ? HUGE_VAL : map.distance_mm / rim_mm, map.median_px, map.max_px,
-                                        static_cast<int>(map.pixels.size()), map.unpredicted});
+                                        static_cast<int>(map.pixels.size()), map.unpredicted,
+                                        map.in_camera_frame_median_px, map.in_camera_frame_max_px});
       if (!std::isfinite(map.max_px))
         warnings.push_back({WarningCode::kPredictedErrorUnknown, "",
                             std::string("the projection error at ") + label + " could not be predicted (no field pixel projects)"});

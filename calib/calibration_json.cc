@@ -17,7 +17,8 @@ using nlohmann::json;
 
 const char* const kPredictedErrorDefinition =
     "per pixel of the observed field: sqrt(trace(J C J^T)), the RMS length of the 2-D error vector of a point at "
-    "that distance from its reflection point, C the fit's covariance (poses marginalised)";
+    "that distance from its reflection point, C the fit's covariance (poses marginalised), J after the best rigid "
+    "alignment as omnical diff compares; in_camera_frame_*: J of points held fixed in the camera's frame";
 
 const char* const kHoldoutDefinition =
     "views kept out of the fit (spread evenly over the input), their poses fitted with the sensor held; rms_px over "
@@ -209,7 +210,9 @@ json ToJson(const CalibrationRecord& r) {
                                     {"median_px", p.median_px},
                                     {"max_px", p.max_px},
                                     {"field_pixels", p.field_pixels},
-                                    {"unpredicted_pixels", p.unpredicted_pixels}});
+                                    {"unpredicted_pixels", p.unpredicted_pixels},
+                                    {"in_camera_frame_median_px", NumberOrNull(p.in_camera_frame_median_px)},
+                                    {"in_camera_frame_max_px", NumberOrNull(p.in_camera_frame_max_px)}});
   }
   if (r.covariance_ok) j["predicted_error_definition"] = kPredictedErrorDefinition;
   j["warnings"] = r.warnings;
@@ -348,7 +351,9 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
       for (const json& p : at("predicted_error"))
         r.predicted_error.push_back({ReadDistance(p.at("distance_mm"), kInfinityMm), ReadDistance(p.at("n_rim_radii"), HUGE_VAL),
                                      NumberOrNan(p.at("median_px")), NumberOrNan(p.at("max_px")),
-                                     p.at("field_pixels").get<int>(), p.at("unpredicted_pixels").get<int>()});
+                                     p.at("field_pixels").get<int>(), p.at("unpredicted_pixels").get<int>(),
+                                     NumberOrNan(p.value("in_camera_frame_median_px", json())),
+                                     NumberOrNan(p.value("in_camera_frame_max_px", json()))});
     r.warnings = at("warnings").get<std::vector<std::string>>();
     if (j.contains("per_view_rms_px"))  // a view left out has no RMS: null
       for (const auto& [image, rms] : at("per_view_rms_px").items()) r.per_view_rms_px[image] = NumberOrNan(rms);

@@ -80,8 +80,9 @@ struct CalibrationRecord {
   struct PredictedErrorSummary {
     double distance_mm = 0.0;  // kInfinityMm (predicted_error.h) for infinity
     double n_rim_radii = 0.0;  // distance in the start's rim radii (HUGE_VAL for infinity)
-    double median_px = 0.0, max_px = 0.0;
+    double median_px = 0.0, max_px = 0.0;  // after the best rigid alignment (calib/predicted_error.h)
     int field_pixels = 0, unpredicted_pixels = 0;
+    double in_camera_frame_median_px = NAN, in_camera_frame_max_px = NAN;  // the frame's own uncertainty kept
   };
   std::vector<PredictedErrorSummary> predicted_error;
   std::vector<std::string> warnings;  // the texts (the codes are in CalibrationResult)

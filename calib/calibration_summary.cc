@@ -1,5 +1,6 @@
 #include "calib/calibration_summary.h"
 
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 
@@ -71,6 +72,17 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
   if (const auto& warp = record.board_warp)
     AppendFormatted(out, "board warp: %.3f +- %.3f mm along x, %.3f +- %.3f mm along y (deflection at the centre)\n",
                     warp->warp.x_mm, warp->std_x_mm, warp->warp.y_mm, warp->std_y_mm);
+  for (const CalibrationRecord::PredictedErrorSummary& p : record.predicted_error) {
+    if (std::isfinite(p.n_rim_radii)) {
+      AppendFormatted(out, "predicted projection error at %.0f mm (n = %.2f): ", p.distance_mm, p.n_rim_radii);
+    } else {
+      out += "predicted projection error at infinity: ";
+    }
+    AppendFormatted(out,
+                    "median %.3f px, worst %.3f px (after the best rigid alignment; in the camera's frame worst %.3f "
+                    "px)\n",
+                    p.median_px, p.max_px, p.in_camera_frame_max_px);
+  }
   if (const auto& knots = record.knot_choice) AppendNamedChoice("knots", NamedKnotChoice(*knots), &out);
   if (const auto& lens = record.lens_choice) AppendNamedChoice("lens", *lens, &out);
   if (const auto& profile = record.profile_choice) AppendNamedChoice("mirror family", *profile, &out);

@@ -1,5 +1,7 @@
 #include "calib/predicted_error.h"
 
+#include <Eigen/Geometry>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -35,6 +37,42 @@ Eigen::Matrix2Xd Projected(const Sensor& sensor, const Eigen::Matrix3Xd& points)
   for (size_t k = 0; k < statuses.size(); ++k)
     if (statuses[k] != ProjectionStatus::kOk) pixels.col(k).setConstant(NAN);
   return pixels;
+}
+
+// sqrt(trace(J C J^T)) for one pixel's 2 x parameters Jacobian J; NaN where the pixel does
+// not project through a step.
+double StdOf(const Eigen::MatrixXd& jacobian, const Eigen::MatrixXd& covariance) {
+  if (!jacobian.allFinite()) return NAN;
+  return std::sqrt(std::max(0.0, (jacobian * covariance * jacobian.transpose()).trace()));
+}
+
+// The pixel motion of the points under a small rigid motion of the sensor's frame, one
+// column per generator (rotation about each axis; at a finite distance also translation
+// along each), rows x0, y0, x1, y1, ... A calibration chooses its frame as freely as the
+// poses allow (a pinhole's principal point with the mirror's tilt and decenter nearly
+// turns the camera), so what these explain is no error: omnical diff and the
+// cross-validation align it away, and so does the prediction.
+Eigen::MatrixXd RigidMotionFields(const Sensor& sensor, const Eigen::Matrix3Xd& points, bool with_translation) {
+  // 1e-6 rad and 1e-4 mm: as the alignment's steps (calib/projection_diff.cc).
+  constexpr double kTurnRad = 1e-6, kShiftMm = 1e-4;
+  const int generators = with_translation ? 6 : 3;
+  Eigen::MatrixXd fields(2 * points.cols(), generators);
+  for (int g = 0; g < generators; ++g) {
+    const int axis = g % 3;
+    const double step = g < 3 ? kTurnRad : kShiftMm;
+    Eigen::Matrix3Xd plus = points, minus = points;
+    if (g < 3) {
+      const Eigen::Matrix3d turn = Eigen::AngleAxisd(step, Eigen::Vector3d::Unit(axis)).toRotationMatrix();
+      plus = turn * points;
+      minus = turn.transpose() * points;
+    } else {
+      plus.row(axis).array() += step;
+      minus.row(axis).array() -= step;
+    }
+    const Eigen::Matrix2Xd moved = (Projected(sensor, plus) - Projected(sensor, minus)) / (2.0 * step);
+    fields.col(g) = Eigen::Map<const Eigen::VectorXd>(moved.data(), moved.size());
+  }
+  return fields;
 }
 
 }  // namespace
@@ -126,27 +164,47 @@ std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const F
     const Eigen::Matrix3Xd points = PointsAt(sensor, pixels, distance_mm);
     // d pixel / d parameter by central differences, a tenth of a std each way: linear
     // there (the solvers' 1e-10 px is far below the ~1e-3 px differences).
-    std::vector<Eigen::Matrix2Xd> derivative(count);
+    Eigen::MatrixXd derivative(2 * pixels.size(), count);  // rows x0, y0, x1, y1, ...
     for (int k = 0; k < count; ++k) {
       const double step = std::max(0.1 * std::sqrt(std::max(0.0, fit.covariance(k, k))), 1e-9 * (1.0 + std::abs(values[index[k]])));
       std::vector<double> plus = values, minus = values;
       plus[index[k]] += step;
       minus[index[k]] -= step;
-      derivative[k] = (Projected(SensorWithParameters(wide, plus), points) -
-                       Projected(SensorWithParameters(wide, minus), points)) / (2.0 * step);
+      const Eigen::Matrix2Xd moved =
+          (Projected(SensorWithParameters(wide, plus), points) - Projected(SensorWithParameters(wide, minus), points)) /
+          (2.0 * step);
+      derivative.col(k) = Eigen::Map<const Eigen::VectorXd>(moved.data(), moved.size());
+    }
+    std::vector<double> in_frame_std_px(pixels.size());
+    for (size_t p = 0; p < pixels.size(); ++p)
+      in_frame_std_px[p] = StdOf(derivative.middleRows(2 * p, 2), fit.covariance);
+    // Less what a rigid motion of the frame explains, least squares over the pixels that
+    // predict (at infinity a translation moves nothing: rotation only), as diff aligns.
+    const Eigen::MatrixXd rigid = RigidMotionFields(wide, points, distance_mm < kInfinityMm);
+    std::vector<Eigen::Index> rows;
+    for (size_t p = 0; p < pixels.size(); ++p)
+      if (derivative.middleRows(2 * p, 2).allFinite() && rigid.middleRows(2 * p, 2).allFinite())
+        rows.insert(rows.end(), {static_cast<Eigen::Index>(2 * p), static_cast<Eigen::Index>(2 * p + 1)});
+    if (rows.size() > 2 * static_cast<size_t>(rigid.cols())) {
+      Eigen::MatrixXd kept_rigid(rows.size(), rigid.cols()), kept_derivative(rows.size(), count);
+      for (size_t r = 0; r < rows.size(); ++r) {
+        kept_rigid.row(r) = rigid.row(rows[r]);
+        kept_derivative.row(r) = derivative.row(rows[r]);
+      }
+      kept_rigid.colwise().normalize();  // turns in rad and shifts in mm move pixels on other scales
+      const Eigen::MatrixXd explained = kept_rigid * kept_rigid.colPivHouseholderQr().solve(kept_derivative);
+      for (size_t r = 0; r < rows.size(); ++r) derivative.row(rows[r]) -= explained.row(r);
     }
     PredictedError map;
     map.distance_mm = distance_mm;
     map.pixels = pixels;
     map.std_px.resize(pixels.size());
     for (size_t p = 0; p < pixels.size(); ++p) {
-      Eigen::Matrix2Xd jacobian(2, count);
-      for (int k = 0; k < count; ++k) jacobian.col(k) = derivative[k].col(p);
-      const double variance = (jacobian * fit.covariance * jacobian.transpose()).trace();
-      map.std_px[p] = jacobian.allFinite() ? std::sqrt(std::max(0.0, variance)) : NAN;
+      map.std_px[p] = StdOf(derivative.middleRows(2 * p, 2), fit.covariance);
       map.unpredicted += !std::isfinite(map.std_px[p]);
     }
     MedianAndMax(map.std_px, &map.median_px, &map.max_px);
+    MedianAndMax(in_frame_std_px, &map.in_camera_frame_median_px, &map.in_camera_frame_max_px);
     maps.push_back(std::move(map));
   }
   return maps;

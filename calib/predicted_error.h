@@ -4,11 +4,21 @@
 // the calibration observed.
 //
 // The point of a pixel at distance D lies D mm along the pixel's ray from its reflection
-// point (the seed paper's n = D / rim radius; D = kInfinityMm for infinity) and is held
-// fixed in the camera frame while the parameters vary. Per point the predicted error is
-// sqrt(trace(J C J^T)), J = d pixel / d parameters (central differences), C the
-// covariance: the RMS length of the 2-D error vector, the same per-corner definition as
-// omnical's reprojection RMS (per coordinate it is smaller by sqrt 2).
+// point (the seed paper's n = D / rim radius; D = kInfinityMm for infinity). Per point the
+// predicted error is sqrt(trace(J C J^T)), J = d pixel / d parameters (central
+// differences), C the covariance: the RMS length of the 2-D error vector, the same
+// per-corner definition as omnical's reprojection RMS (per coordinate it is smaller by
+// sqrt 2).
+//
+// J is taken after the best rigid alignment, as omnical diff and the cross-validation
+// compare two calibrations (calib/projection_diff.h): the part of each parameter's pixel
+// motion that a rigid motion of the frame explains (least squares over the field;
+// rotation only at infinity) is removed. Board poses absorb any rigid motion of the
+// frame, so the data fix it only through small effects (a pinhole's principal point with
+// the mirror's tilt and decenter nearly turns the camera; the dolly zoom, fx with m,
+// nearly slides the mirror's rays along the axis): kept, that uncertainty of where the
+// camera's frame sits dominated (6.5 px at n = 2 where the fit was 0.07 px off after
+// alignment, calibration_trust_test.cc). It is still reported, as in_camera_frame_*.
 #pragma once
 
 #include <Eigen/Core>
@@ -42,6 +52,10 @@ struct PredictedError {
   std::vector<double> std_px;  // per pixel (NaN where the point does not project)
   double median_px = 0.0, max_px = 0.0;  // over the predicted pixels
   int unpredicted = 0;                    // pixels whose point did not project
+  // The same with the frame's own uncertainty kept: points held fixed in the camera's
+  // frame, no alignment (what matters only where that frame is itself used, e.g. the
+  // camera's mount measured as the reference).
+  double in_camera_frame_median_px = 0.0, in_camera_frame_max_px = 0.0;
 };
 
 // One map per distance. `fit` supplies the parameters and covariance (FitResult's

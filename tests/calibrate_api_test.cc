@@ -125,6 +125,8 @@ TEST(CalibrateApi, RecordRoundTripsThroughCalibrationJson) {
   EXPECT_EQ((back.covariance - result.record.covariance).cwiseAbs().maxCoeff(), 0.0);
   ASSERT_EQ(back.predicted_error.size(), 1u);
   EXPECT_EQ(back.predicted_error[0].max_px, result.record.predicted_error[0].max_px);
+  EXPECT_TRUE(std::isfinite(result.record.predicted_error[0].in_camera_frame_max_px));
+  EXPECT_EQ(back.predicted_error[0].in_camera_frame_max_px, result.record.predicted_error[0].in_camera_frame_max_px);
   // A knot choice (its numbers set here: choosing takes 30 fits) with a failed candidate.
   CalibrationRecord chosen = result.record;
   chosen.knot_choice = KnotChoice{"polynomial", kKnotCandidates, {0.31, 0.3, NAN, 0.33, 0.34, 0.5}, 384, 5, 4};

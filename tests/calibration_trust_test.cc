@@ -18,6 +18,7 @@
 #include "calib/bundle_fit.h"
 #include "calib/calibrate.h"
 #include "calib/predicted_error.h"
+#include "calib/projection_diff.h"
 #include "calib/synthetic/ground_truth.h"
 #include "calib/synthetic/renderer.h"
 #include "test_sensors.h"
@@ -77,6 +78,18 @@ DetectionSet ExactViews(const CalibrationTarget& board, const Placement& placeme
 }
 
 // 12 views of the aprilgrid 5-10 rim radii from the vertex.
+// How far `fit` places the points at distance_mm along the truth's rays from where the
+// truth sees them, after the best rigid alignment (omnical diff's measure, which the
+// predicted error predicts): per pixel, NaN where either does not project.
+std::vector<double> AlignedDisplacement(const Sensor& fit, const std::vector<Eigen::Vector2d>& pixels,
+                                        double distance_mm) {
+  const ProjectionDiff diff = CompareProjections(Truth(), fit, pixels, distance_mm);
+  EXPECT_TRUE(diff.aligned) << distance_mm << " mm";
+  std::vector<double> lengths;
+  for (const Eigen::Vector2d& d : diff.difference_px) lengths.push_back(d.norm());
+  return lengths;
+}
+
 DetectionSet NearViews() { return ExactViews(Board(), {45.0, 115.0, 5.0, 10.0, 20.0, 12, 23}); }
 
 DetectionSet WithNoise(DetectionSet set, double sigma_px, unsigned seed) {
@@ -257,9 +270,11 @@ TEST(BundleFit, ToleranceEntersTheFitAndItsCovariance) {
 const std::vector<double> kDistancesN = {2.0, 7.0, kInfinityMm / testing::kRimMm};
 
 // The trust issue's near-only scene with k1, k2 free and no tolerances: the fit is good
-// (0.05 px corners) but the fx-m dolly zoom lets it misplace near objects. Either it lands
-// within 0.3 px of the truth at n = 2, 7 and infinity, or the predicted error says so
-// (above the 0.3 px warning) and its 3-sigma bound covers the actual error.
+// (0.05 px corners) but the fx-m dolly zoom is free. In the camera's own frame that moves
+// objects at n = 2 by 6.5 px (measured), but it moves the mirror's rays along the axis
+// almost rigidly: after the best rigid alignment the fit is 0.07 / 0.06 / 0.14 px off at
+// n = 2, 7 and infinity. The predicted error (the same measure) must cover that within 3
+// of its stds, and warn wherever the fit is off by more than the 0.3 px threshold.
 TEST(PredictedError, NearOnlyDistortionFreeFitWarnsWhereItIsOff) {
   const DetectionSet set = WithNoise(NearViews(), 0.05, 11);
   const Sensor guess = LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-sph-misaligned-guess.yaml");
@@ -270,15 +285,19 @@ TEST(PredictedError, NearOnlyDistortionFreeFitWarnsWhereItIsOff) {
   for (double n : kDistancesN) {
     const double distance_mm = n * testing::kRimMm;
     const PredictedError predicted = PredictProjectionError(*fit.sensor, fit, pixels, {distance_mm})[0];
-    double actual_median = 0.0, actual_max = 0.0;
-    MedianAndMax(ProjectionDisplacement(Truth(), *fit.sensor, pixels, distance_mm), &actual_median, &actual_max);
+    double actual_median = 0.0, actual_max = 0.0, in_frame_median = 0.0, in_frame_max = 0.0;
+    MedianAndMax(AlignedDisplacement(*fit.sensor, pixels, distance_mm), &actual_median, &actual_max);
+    MedianAndMax(ProjectionDisplacement(Truth(), *fit.sensor, pixels, distance_mm), &in_frame_median, &in_frame_max);
     RecordProperty("n" + std::to_string(n) + "_actual_max_px", std::to_string(actual_max));
     RecordProperty("n" + std::to_string(n) + "_predicted_max_px", std::to_string(predicted.max_px));
-    std::printf("n = %g: actual median %.3f max %.3f px; predicted median %.3f max %.3f px\n", n, actual_median, actual_max,
-                predicted.median_px, predicted.max_px);
+    std::printf("n = %g: actual median %.3f max %.3f px; predicted median %.3f max %.3f px; in the camera's frame "
+                "actual max %.2f px, predicted %.2f px\n",
+                n, actual_median, actual_max, predicted.median_px, predicted.max_px, in_frame_max,
+                predicted.in_camera_frame_max_px);
+    EXPECT_LE(actual_max, 3.0 * predicted.max_px) << "n = " << n;
+    EXPECT_LE(in_frame_max, 3.0 * predicted.in_camera_frame_max_px) << "n = " << n;
     if (actual_max > 0.3) {
       EXPECT_GT(predicted.max_px, 0.3) << "n = " << n << ": off by " << actual_max << " px without a warning";
-      EXPECT_LE(actual_max, 3.0 * predicted.max_px) << "n = " << n;
     }
   }
 }
@@ -317,7 +336,7 @@ TEST(PredictedError, MonteCarloSpreadMatchesThePrediction) {
     for (size_t d = 0; d < kDistancesN.size(); ++d) {
       const double distance_mm = kDistancesN[d] * testing::kRimMm;
       const PredictedError predicted = PredictProjectionError(*fit.sensor, fit, pixels, {distance_mm})[0];
-      const std::vector<double> actual = ProjectionDisplacement(Truth(), *fit.sensor, pixels, distance_mm);
+      const std::vector<double> actual = AlignedDisplacement(*fit.sensor, pixels, distance_mm);
       for (size_t p = 0; p < pixels.size(); ++p) {
         predicted_variance[d][p] += predicted.std_px[p] * predicted.std_px[p] / kRuns;
         actual_square[d][p] += actual[p] * actual[p] / kRuns;
@@ -366,9 +385,13 @@ DetectionSet RimCheckerboardViews(const CalibrationTarget& board, unsigned seed)
 }
 
 // Measured (3 seeds): without tolerances m lands at 175-190 mm (truth 180.4, std 7-11)
-// and objects at n = 7 are misplaced by 6.4-11.2 px; with the design tolerances m is
-// within 0.9 mm and n = 7 within 0.6-3.0 px. Either way the reported std covers the error (no wrong
-// basin that the statistics hide) and the predicted error warns where the fit is off.
+// and, in the camera's own frame, objects at n = 7 are misplaced by 6.4-11.2 px; with the
+// design tolerances m is within 0.9 mm and n = 7 within 0.6-3.0 px. That misplacement is
+// almost all a rigid motion of the frame (the dolly zoom moves the mirror's ray bundle
+// along the axis): after the best rigid alignment the fits are 0.08-0.21 px off without
+// tolerances, 0.05-0.10 with, and the predicted error (0.11-0.20 and 0.07 px) covers it.
+// Either way the reported std covers the parameters' error (no wrong basin that the
+// statistics hide), and the tolerances pin the frame.
 TEST(WrongBasin, RimCheckerboardsStayHonestAndTolerancesPullThemIn) {
   const CalibrationTarget board =
       CalibrationTarget::FromYaml(testing::SourceDir() + "/datasets-synthetic/targets/checkerboard-8x6-30mm.yaml");
@@ -390,16 +413,23 @@ TEST(WrongBasin, RimCheckerboardsStayHonestAndTolerancesPullThemIn) {
             << "seed " << seed << (tolerances ? " with" : " without") << " tolerances: " << fit.parameters[k].name;
       }
       const std::vector<Eigen::Vector2d> pixels = FieldPixels(*fit.sensor, FieldOfCorners(*fit.sensor, set), 16.0);
-      double median = 0.0, actual = 0.0;
-      MedianAndMax(ProjectionDisplacement(Truth(), *fit.sensor, pixels, 7 * testing::kRimMm), &median, &actual);
+      double median = 0.0, actual = 0.0, in_frame = 0.0;
+      MedianAndMax(AlignedDisplacement(*fit.sensor, pixels, 7 * testing::kRimMm), &median, &actual);
+      MedianAndMax(ProjectionDisplacement(Truth(), *fit.sensor, pixels, 7 * testing::kRimMm), &median, &in_frame);
       const PredictedError predicted = PredictProjectionError(*fit.sensor, fit, pixels, {7 * testing::kRimMm})[0];
-      std::printf("seed %u %s tolerances: m %.2f +- %.2f mm; n = 7 off by up to %.2f px, predicted %.2f px\n", seed,
-                  tolerances ? "with" : "without", fit.parameters[6].value, fit.parameters[6].std, actual, predicted.max_px);
+      const auto m = std::find_if(fit.parameters.begin(), fit.parameters.end(),
+                                  [](const ParameterEstimate& p) { return p.name == "m_mm"; });
+      ASSERT_NE(m, fit.parameters.end());
+      std::printf("seed %u %s tolerances: m %.2f +- %.2f mm; n = 7 off by up to %.2f px aligned (predicted %.2f), "
+                  "%.2f px in the camera's frame\n",
+                  seed, tolerances ? "with" : "without", m->value, m->std, actual, predicted.max_px, in_frame);
+      // The worst pixel within 3 predicted stds of its worst (one realisation of a field
+      // dominated by a few parameter directions: a 3-sigma bound).
+      EXPECT_LT(actual, 3.0 * predicted.max_px) << "seed " << seed;
       if (actual > 0.3) {
         EXPECT_GT(predicted.max_px, 0.3) << "seed " << seed;
-        EXPECT_LT(actual, 3.0 * predicted.max_px) << "seed " << seed;
       }
-      (tolerances ? off_with : off_without) += actual;
+      (tolerances ? off_with : off_without) += in_frame;
     }
   }
   EXPECT_LT(off_with, 0.5 * off_without);

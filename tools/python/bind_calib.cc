@@ -326,12 +326,15 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
           out.append(py::dict("distance_mm"_a = infinite ? HUGE_VAL : p.distance_mm,
                               "n_rim_radii"_a = infinite ? HUGE_VAL : p.n_rim_radii, "median_px"_a = p.median_px,
                               "max_px"_a = p.max_px, "field_pixels"_a = p.field_pixels,
-                              "unpredicted_pixels"_a = p.unpredicted_pixels));
+                              "unpredicted_pixels"_a = p.unpredicted_pixels,
+                              "in_camera_frame_median_px"_a = p.in_camera_frame_median_px,
+                              "in_camera_frame_max_px"_a = p.in_camera_frame_max_px));
         }
         return out;
       },
       "The predicted projection error per distance: list of dicts (distance_mm (inf for infinity), n_rim_radii, "
-      "median_px, max_px, field_pixels, unpredicted_pixels).");
+      "median_px, max_px (after the best rigid alignment, as diff), field_pixels, unpredicted_pixels, "
+      "in_camera_frame_median_px, in_camera_frame_max_px (points held in the camera's frame)).");
   cls.def(
       "to_json", [record](const Holder& holder) { return CalibrationJsonText(record(holder)); },
       "The text of calibration.json.");
