@@ -1042,7 +1042,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
         char text[400];
         std::snprintf(text, sizeof text,
                       "predicted projection error up to %.2f px (median %.2f) at %s exceeds %.2f px: the calibration "
-                      "may misplace objects there by that much; %s would help",
+                      "may misplace objects there, one against another, by that much; %s would help",
                       map.max_px, map.median_px, label, options.max_predicted_error_px, joined.c_str());
         warnings.push_back({WarningCode::kPredictedErrorHigh, "", text});
       }

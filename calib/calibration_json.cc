@@ -207,8 +207,8 @@ json ToJson(const CalibrationRecord& r) {
     const bool infinite = p.distance_mm >= kInfinityMm;
     j["predicted_error"].push_back({{"distance_mm", DistanceOrInfinity(p.distance_mm, infinite)},
                                     {"n_rim_radii", DistanceOrInfinity(p.n_rim_radii, infinite)},
-                                    {"median_px", p.median_px},
-                                    {"max_px", p.max_px},
+                                    {"median_px", NumberOrNull(p.median_px)},
+                                    {"max_px", NumberOrNull(p.max_px)},
                                     {"field_pixels", p.field_pixels},
                                     {"unpredicted_pixels", p.unpredicted_pixels},
                                     {"in_camera_frame_median_px", NumberOrNull(p.in_camera_frame_median_px)},
@@ -348,12 +348,23 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
     }
     if (j.contains("scale_block_condition")) r.scale_block_condition = at("scale_block_condition").get<double>();
     if (j.contains("predicted_error"))
-      for (const json& p : at("predicted_error"))
-        r.predicted_error.push_back({ReadDistance(p.at("distance_mm"), kInfinityMm), ReadDistance(p.at("n_rim_radii"), HUGE_VAL),
-                                     NumberOrNan(p.at("median_px")), NumberOrNan(p.at("max_px")),
-                                     p.at("field_pixels").get<int>(), p.at("unpredicted_pixels").get<int>(),
-                                     NumberOrNan(p.value("in_camera_frame_median_px", json())),
-                                     NumberOrNan(p.value("in_camera_frame_max_px", json()))});
+      for (const json& p : at("predicted_error")) {
+        CalibrationRecord::PredictedErrorSummary summary{
+            ReadDistance(p.at("distance_mm"), kInfinityMm), ReadDistance(p.at("n_rim_radii"), HUGE_VAL),
+            NumberOrNan(p.at("median_px")),                 NumberOrNan(p.at("max_px")),
+            p.at("field_pixels").get<int>(),                p.at("unpredicted_pixels").get<int>()};
+        if (p.contains("in_camera_frame_max_px")) {
+          summary.in_camera_frame_median_px = NumberOrNan(p.at("in_camera_frame_median_px"));
+          summary.in_camera_frame_max_px = NumberOrNan(p.at("in_camera_frame_max_px"));
+        } else {
+          // Written before the prediction was aligned (2026-11-29): its figures were the
+          // camera frame's, and the aligned ones are unknown.
+          summary.in_camera_frame_median_px = summary.median_px;
+          summary.in_camera_frame_max_px = summary.max_px;
+          summary.median_px = summary.max_px = NAN;
+        }
+        r.predicted_error.push_back(summary);
+      }
     r.warnings = at("warnings").get<std::vector<std::string>>();
     if (j.contains("per_view_rms_px"))  // a view left out has no RMS: null
       for (const auto& [image, rms] : at("per_view_rms_px").items()) r.per_view_rms_px[image] = NumberOrNan(rms);

@@ -55,6 +55,7 @@ struct PredictedError {
   // The same with the frame's own uncertainty kept: points held fixed in the camera's
   // frame, no alignment (what matters only where that frame is itself used, e.g. the
   // camera's mount measured as the reference).
+  std::vector<double> in_camera_frame_std_px;
   double in_camera_frame_median_px = 0.0, in_camera_frame_max_px = 0.0;
 };
 

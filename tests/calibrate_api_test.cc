@@ -3,6 +3,7 @@
 // its ground-truth corners, from images in memory, cancelled through the callback, and
 // calibration.json written and read back.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <random>
 #include <filesystem>
+#include <fstream>
 #include <regex>
 #include <set>
 #include <type_traits>
@@ -127,6 +129,16 @@ TEST(CalibrateApi, RecordRoundTripsThroughCalibrationJson) {
   EXPECT_EQ(back.predicted_error[0].max_px, result.record.predicted_error[0].max_px);
   EXPECT_TRUE(std::isfinite(result.record.predicted_error[0].in_camera_frame_max_px));
   EXPECT_EQ(back.predicted_error[0].in_camera_frame_max_px, result.record.predicted_error[0].in_camera_frame_max_px);
+  {
+    // A file from before the aligned prediction: its figures were the camera frame's.
+    nlohmann::json old = nlohmann::json::parse(CalibrationJsonText(result.record));
+    for (auto& p : old["predicted_error"]) p.erase("in_camera_frame_median_px"), p.erase("in_camera_frame_max_px");
+    std::ofstream(path) << old.dump();
+    const CalibrationRecord relabelled = ReadCalibrationJson(path);
+    std::filesystem::remove(path);
+    EXPECT_EQ(relabelled.predicted_error[0].in_camera_frame_max_px, result.record.predicted_error[0].max_px);
+    EXPECT_TRUE(std::isnan(relabelled.predicted_error[0].max_px));
+  }
   // A knot choice (its numbers set here: choosing takes 30 fits) with a failed candidate.
   CalibrationRecord chosen = result.record;
   chosen.knot_choice = KnotChoice{"polynomial", kKnotCandidates, {0.31, 0.3, NAN, 0.33, 0.34, 0.5}, 384, 5, 4};

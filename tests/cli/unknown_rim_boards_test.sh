@@ -57,11 +57,28 @@ assert cal["detection_passes"] == 3, cal["detection_passes"]
 assert used >= 0.99 * visible, (used, visible)
 assert diff[300]["aligned"] and diff[300]["diff_rms_px"] < 0.05 and diff[2000]["diff_rms_px"] < 0.1, diff
 # The predicted error at the boards' median distance covers the actual one (3 sigma) and
-# is not far above it: 0.23 px predicted against 0.041 px actual (worst pixels; measured
-# 2026-11-29). Taken in the camera's frame it read 1.98 px and warned (bound: 0.5 px).
+# does not warn: 0.089 px predicted against 0.041 px actual (worst pixels; measured
+# 2026-11-29). Taken in the camera's frame it read 1.98 px and warned.
 predicted = cal["predicted_error"][0]
 actual = json.load(open("%s/diff_%s/diff.json" % (work, sys.argv[3])))["diff_max_px"]
 print("at %.0f mm: predicted worst %.3f px, actual %.3f px" % (predicted["distance_mm"], predicted["max_px"], actual))
-assert actual <= 3 * predicted["max_px"] and predicted["max_px"] < 0.5, (predicted, actual)
+assert actual <= 3 * predicted["max_px"] and predicted["max_px"] < 0.3, (predicted, actual)
+# Every parameter within 3 reported std of the render's true sphere (the issue's), read
+# from its sensor.yaml: a sphere of radius A is a conic of vertex radius A and k = 0.
+# Measured: worst R, 1.66 std (49.590 +- 0.222 mm vs 49.958); the tilt and decenter are
+# a sphere's gauge (stds of 5-35 deg, 4-30 mm) and pass trivially.
+import re
+text = open(set_dir + "/sensor.yaml").read()
+number = lambda key: float(re.search(r"\b%s: ([-0-9.e]+)" % key, text).group(1))
+pair = lambda key: [float(v) for v in re.search(r"%s: \[([^]]*)\]" % key, text).group(1).split(",")]
+truth = {"fx_px": number("fx"), "fy_px": number("fy"), "cx_px": number("cx"), "cy_px": number("cy"), "k1": 0.0,
+         "k2": 0.0, "m_mm": number("m"), "R_mm": number("A"), "k": 0.0, "tilt_x_deg": pair("tilt_deg")[0],
+         "tilt_y_deg": pair("tilt_deg")[1], "decenter_x_mm": pair("decenter_mm")[0],
+         "decenter_y_mm": pair("decenter_mm")[1]}
+assert number("k1") == 0.0 and number("k2") == 0.0, text
+deviation = {name: abs(cal["parameters"][name]["value"] - value) / cal["parameters"][name]["std"]
+             for name, value in truth.items()}
+print("parameters from the truth, in std: " + ", ".join("%s %.2f" % item for item in sorted(deviation.items())))
+assert max(deviation.values()) < 3.0, deviation
 PY
 summary unknown_rim_boards_test
