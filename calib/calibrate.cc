@@ -988,15 +988,20 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     WarnIfHeldOutWorse("the " + std::to_string(record.holdout->images.size()) + " held-out views fit at",
                        record.holdout->rms_px, record.rms_all_px, &warnings);
   }
+  // Where the boards were: the predicted error's and the halves' one rigid alignment is
+  // fitted there (calib/predicted_error.h); NaN (no corner projects): per distance.
+  const double boards_median_mm = MedianCornerDistanceMm(*fit.sensor, input.target, usable, fit);
   if (options.cross_validate) {
     double distance_mm = options.cross_validation_distance_mm;
     if (!(distance_mm > 0.0)) distance_mm = !options.distances_mm.empty()   ? options.distances_mm.front()
                                             : !options.distances_n.empty() ? options.distances_n.front() * rim_mm
                                                                            : kDefaultCrossValidationDistanceMm;
     ProgressReporter progress(options.progress, "cross-validation", 1);
-    TwoHalves halves = CrossValidateHalves(fit_start, input.target, fitted_views, fitted_start_poses, fit_options, field, distance_mm);
+    TwoHalves halves = CrossValidateHalves(fit_start, input.target, fitted_views, fitted_start_poses, fit_options, field,
+                                           distance_mm, boards_median_mm);
     progress.Step();
-    record.cross_validation = CalibrationRecord::CrossValidationRecord{halves.images, halves.rms_px, std::move(halves.diff)};
+    record.cross_validation = CalibrationRecord::CrossValidationRecord{
+        halves.images, halves.rms_px, std::move(halves.diff), std::move(halves.diff_aligned_at_boards)};
   }
 
   // The error at the user's distances: the covariance through the projection over the
@@ -1006,11 +1011,10 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     std::vector<double> distances = options.distances_mm;
     for (double n : options.distances_n) distances.push_back(n * rim_mm);
     if (distances.empty()) {
-      if (const double median_mm = MedianCornerDistanceMm(*fit.sensor, input.target, usable, fit); std::isfinite(median_mm))
-        distances.push_back(median_mm);
+      if (std::isfinite(boards_median_mm)) distances.push_back(boards_median_mm);
       distances.push_back(kInfinityMm);
     }
-    predicted = PredictProjectionError(*fit.sensor, fit, field, distances);
+    predicted = PredictProjectionError(*fit.sensor, fit, field, distances, boards_median_mm);
     for (const PredictedError& map : predicted) {
       const bool infinite = map.distance_mm >= kInfinityMm;
       char label[80];
@@ -1022,7 +1026,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
       distance_labels.push_back(label);
       record.predicted_error.push_back({map.distance_mm, infinite ? HUGE_VAL : map.distance_mm / rim_mm, map.median_px, map.max_px,
                                         static_cast<int>(map.pixels.size()), map.unpredicted,
-                                        map.in_camera_frame_median_px, map.in_camera_frame_max_px});
+                                        map.in_camera_frame_median_px, map.in_camera_frame_max_px, map.aligned_at_mm});
       if (!std::isfinite(map.max_px))
         warnings.push_back({WarningCode::kPredictedErrorUnknown, "",
                             std::string("the projection error at ") + label + " could not be predicted (no field pixel projects)"});

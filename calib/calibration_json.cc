@@ -17,8 +17,9 @@ using nlohmann::json;
 
 const char* const kPredictedErrorDefinition =
     "per pixel of the observed field: sqrt(trace(J C J^T)), the RMS length of the 2-D error vector of a point at "
-    "that distance from its reflection point, C the fit's covariance (poses marginalised), J after the best rigid "
-    "alignment as omnical diff compares; in_camera_frame_*: J of points held fixed in the camera's frame";
+    "that distance from its reflection point, C the fit's covariance (poses marginalised), J after the rigid "
+    "alignment fitted at aligned_at_mm (the boards' median distance) and applied at every distance, as omnical diff "
+    "--align-at-mm compares; in_camera_frame_*: J of points held fixed in the camera's frame";
 
 const char* const kHoldoutDefinition =
     "views kept out of the fit (spread evenly over the input), their poses fitted with the sensor held; rms_px over "
@@ -62,7 +63,9 @@ const char* const kTangentialChoiceDefinition =
 const char* const kCrossValidationDefinition =
     "the usable views split into even and odd positions, each half calibrated alone; the points distance_mm along "
     "each observed field pixel's ray through half 1 (from its reflection point), moved by the rigid motion that "
-    "best aligns them, projected through half 2; diff_*_px are lengths of the 2-D pixel differences";
+    "best aligns them, projected through half 2; diff_*_px are lengths of the 2-D pixel differences; aligned_at_boards: "
+    "the same with one rigid motion fitted at aligned_at_mm (the boards' median distance) and carried to distance_mm, "
+    "as the predicted error";
 
 json NumberOrNull(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 double NumberOrNan(const json& value) { return value.is_null() ? NAN : value.get<double>(); }
@@ -106,8 +109,29 @@ json DiffSummary(const ProjectionDiff& d) {
           {"unaligned_rms_px", NumberOrNull(d.unaligned_rms_px)},
           {"grid_points", d.compared},
           {"aligned", d.aligned},
+          {"aligned_at_mm", NumberOrNull(d.aligned_at_mm)},
           {"rotation_deg", d.rotation_deg},
           {"translation_mm", {d.translation_mm.x(), d.translation_mm.y(), d.translation_mm.z()}}};
+}
+
+// DiffSummary's fields back (no per-pixel data).
+ProjectionDiff ReadDiffSummary(const json& c) {
+  ProjectionDiff diff;
+  diff.distance_mm = ReadDistance(c.at("distance_mm"), kInfinityMm);
+  diff.rms_px = NumberOrNan(c.at("diff_rms_px"));
+  diff.median_px = NumberOrNan(c.at("diff_median_px"));
+  diff.max_px = NumberOrNan(c.at("diff_max_px"));
+  diff.unaligned_rms_px = NumberOrNan(c.at("unaligned_rms_px"));
+  diff.compared = c.at("grid_points").get<int>();
+  diff.aligned = c.at("aligned").get<bool>();
+  diff.rotation_deg = c.at("rotation_deg").get<double>();
+  // Older files: an alignment was always fitted at the compared distance.
+  diff.aligned_at_mm = c.contains("aligned_at_mm") ? NumberOrNan(c.at("aligned_at_mm"))
+                       : diff.aligned              ? diff.distance_mm
+                                                   : NAN;
+  const json& t = c.at("translation_mm");
+  diff.translation_mm = Eigen::Vector3d(t.at(0).get<double>(), t.at(1).get<double>(), t.at(2).get<double>());
+  return diff;
 }
 
 json ToJson(const CalibrationRecord& r) {
@@ -176,6 +200,7 @@ json ToJson(const CalibrationRecord& r) {
     out = DiffSummary(c->diff);
     out["halves"] = c->halves;
     out["half_rms_px"] = {NumberOrNull(c->half_rms_px[0]), NumberOrNull(c->half_rms_px[1])};
+    if (c->diff_aligned_at_boards) out["aligned_at_boards"] = DiffSummary(*c->diff_aligned_at_boards);
     out["definition"] = kCrossValidationDefinition;
   }
   j["target_distance_mm"] = {{"nearest", r.nearest_target_mm}, {"farthest", r.farthest_target_mm}};
@@ -212,7 +237,8 @@ json ToJson(const CalibrationRecord& r) {
                                     {"field_pixels", p.field_pixels},
                                     {"unpredicted_pixels", p.unpredicted_pixels},
                                     {"in_camera_frame_median_px", NumberOrNull(p.in_camera_frame_median_px)},
-                                    {"in_camera_frame_max_px", NumberOrNull(p.in_camera_frame_max_px)}});
+                                    {"in_camera_frame_max_px", NumberOrNull(p.in_camera_frame_max_px)},
+                                    {"aligned_at_mm", NumberOrNull(p.aligned_at_mm)}});
   }
   if (r.covariance_ok) j["predicted_error_definition"] = kPredictedErrorDefinition;
   j["warnings"] = r.warnings;
@@ -315,16 +341,8 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
       CalibrationRecord::CrossValidationRecord cross;
       cross.halves = c.at("halves").get<std::array<std::vector<std::string>, 2>>();
       cross.half_rms_px = {NumberOrNan(c.at("half_rms_px").at(0)), NumberOrNan(c.at("half_rms_px").at(1))};
-      cross.diff.distance_mm = ReadDistance(c.at("distance_mm"), kInfinityMm);
-      cross.diff.rms_px = NumberOrNan(c.at("diff_rms_px"));
-      cross.diff.median_px = NumberOrNan(c.at("diff_median_px"));
-      cross.diff.max_px = NumberOrNan(c.at("diff_max_px"));
-      cross.diff.unaligned_rms_px = NumberOrNan(c.at("unaligned_rms_px"));
-      cross.diff.compared = c.at("grid_points").get<int>();
-      cross.diff.aligned = c.at("aligned").get<bool>();
-      cross.diff.rotation_deg = c.at("rotation_deg").get<double>();
-      const json& t = c.at("translation_mm");
-      cross.diff.translation_mm = Eigen::Vector3d(t.at(0).get<double>(), t.at(1).get<double>(), t.at(2).get<double>());
+      cross.diff = ReadDiffSummary(c);
+      if (c.contains("aligned_at_boards")) cross.diff_aligned_at_boards = ReadDiffSummary(c.at("aligned_at_boards"));
       r.cross_validation = cross;
     }
     const json& distance = at("target_distance_mm");
@@ -363,6 +381,7 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
           summary.in_camera_frame_max_px = summary.max_px;
           summary.median_px = summary.max_px = NAN;
         }
+        if (p.contains("aligned_at_mm")) summary.aligned_at_mm = NumberOrNan(p.at("aligned_at_mm"));
         r.predicted_error.push_back(summary);
       }
     r.warnings = at("warnings").get<std::vector<std::string>>();

@@ -60,6 +60,7 @@ struct CalibrationRecord {
     std::array<std::vector<std::string>, 2> halves;
     std::array<double, 2> half_rms_px{{NAN, NAN}};
     ProjectionDiff diff;
+    std::optional<ProjectionDiff> diff_aligned_at_boards;  // calib/cross_validation.h
   };
   std::optional<CrossValidationRecord> cross_validation;
   double nearest_target_mm = 0.0, farthest_target_mm = 0.0;  // fitted views, from the lens
@@ -83,6 +84,9 @@ struct CalibrationRecord {
     double median_px = 0.0, max_px = 0.0;  // after the best rigid alignment (calib/predicted_error.h)
     int field_pixels = 0, unpredicted_pixels = 0;
     double in_camera_frame_median_px = NAN, in_camera_frame_max_px = NAN;  // the frame's own uncertainty kept
+    // Where the one rigid alignment was fitted (the boards' median distance); NaN: at each
+    // distance (files written before 2026-11-29's second change) or none.
+    double aligned_at_mm = NAN;
   };
   std::vector<PredictedErrorSummary> predicted_error;
   std::vector<std::string> warnings;  // the texts (the codes are in CalibrationResult)

@@ -78,10 +78,13 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
     } else {
       out += "predicted projection error at infinity: ";
     }
-    AppendFormatted(out,
-                    "median %.3f px, worst %.3f px (after the best rigid alignment; in the camera's frame worst %.3f "
-                    "px)\n",
-                    p.median_px, p.max_px, p.in_camera_frame_max_px);
+    AppendFormatted(out, "median %.3f px, worst %.3f px (", p.median_px, p.max_px);
+    if (std::isfinite(p.aligned_at_mm)) {
+      AppendFormatted(out, "after the rigid alignment fitted at %.0f mm, the boards' median distance", p.aligned_at_mm);
+    } else {
+      out += "after the best rigid alignment";
+    }
+    AppendFormatted(out, "; in the camera's frame worst %.3f px)\n", p.in_camera_frame_max_px);
   }
   if (const auto& knots = record.knot_choice) AppendNamedChoice("knots", NamedKnotChoice(*knots), &out);
   if (const auto& lens = record.lens_choice) AppendNamedChoice("lens", *lens, &out);
@@ -105,6 +108,12 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
                     cross->diff.aligned ? "after the best rigid alignment" : "alignment FAILED, unaligned",
                     cross->diff.rotation_deg,
                     cross->diff.translation_mm.norm());
+  if (const auto& cross = record.cross_validation; cross && cross->diff_aligned_at_boards)
+    AppendFormatted(out,
+                    "  with one rigid alignment fitted at the boards' %.0f mm (as the predicted error): %.4f px RMS, %.4f "
+                    "px max\n",
+                    cross->diff_aligned_at_boards->aligned_at_mm, cross->diff_aligned_at_boards->rms_px,
+                    cross->diff_aligned_at_boards->max_px);
   return out;
 }
 

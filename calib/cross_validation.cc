@@ -100,7 +100,8 @@ HeldOutViews EvaluateHeldOutViews(const Sensor& sensor, const CalibrationTarget&
 
 TwoHalves CrossValidateHalves(const Sensor& start, const CalibrationTarget& target, const DetectionSet& views,
                               const std::vector<TargetPose>& initial_poses, FitOptions options,
-                              const std::vector<Eigen::Vector2d>& field_pixels, double distance_mm) {
+                              const std::vector<Eigen::Vector2d>& field_pixels, double distance_mm,
+                              double align_at_mm) {
   options.compute_covariance = false;
   options.progress = nullptr;
   TwoHalves halves;
@@ -123,6 +124,15 @@ TwoHalves CrossValidateHalves(const Sensor& start, const CalibrationTarget& targ
     halves.sensors.push_back(*fit.sensor);
   }
   halves.diff = CompareProjections(halves.sensors[0], halves.sensors[1], field_pixels, distance_mm);
+  if (!std::isnan(align_at_mm)) {
+    try {
+      halves.diff_aligned_at_boards =
+          CompareProjections(halves.sensors[0], halves.sensors[1], field_pixels, distance_mm, true, align_at_mm);
+    } catch (const InputError&) {
+      // Too few field pixels project at the boards' distance: the figure is left out, the
+      // halves' comparison at distance_mm stands.
+    }
+  }
   return halves;
 }
 

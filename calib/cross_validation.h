@@ -12,7 +12,9 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -74,7 +76,11 @@ struct TwoHalves {
   std::array<std::vector<std::string>, 2> images;  // even and odd positions of the fitted views
   std::array<double, 2> rms_px{{NAN, NAN}};       // each half's own fit, inliers
   std::vector<Sensor> sensors;  // the two halves' fits, in that order
-  ProjectionDiff diff;  // sensors[1] against sensors[0]
+  ProjectionDiff diff;  // sensors[1] against sensors[0], aligned at distance_mm
+  // The same with one rigid motion fitted at align_at_mm (the boards' median distance) and
+  // carried to distance_mm, as calibrate's predicted error (calib/projection_diff.h);
+  // empty without align_at_mm or where too few field pixels project there.
+  std::optional<ProjectionDiff> diff_aligned_at_boards;
 };
 
 // Each half fitted from `start` (the full fit's start, same options, no covariance), then
@@ -82,6 +88,7 @@ struct TwoHalves {
 // 3 views or its fit fails.
 TwoHalves CrossValidateHalves(const Sensor& start, const CalibrationTarget& target, const DetectionSet& views,
                               const std::vector<TargetPose>& initial_poses, FitOptions options,
-                              const std::vector<Eigen::Vector2d>& field_pixels, double distance_mm);
+                              const std::vector<Eigen::Vector2d>& field_pixels, double distance_mm,
+                              double align_at_mm = NAN);
 
 }  // namespace omnical

@@ -75,6 +75,25 @@ Eigen::MatrixXd RigidMotionFields(const Sensor& sensor, const Eigen::Matrix3Xd& 
   return fields;
 }
 
+// The rigid motion (generators x parameters) that best explains each parameter's pixel
+// motion, least squares over the pixels where both are finite; false where too few are.
+bool FitRigidMotion(const Eigen::MatrixXd& rigid, const Eigen::MatrixXd& derivative, Eigen::MatrixXd* motion) {
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index r = 0; r + 1 < rigid.rows(); r += 2)
+    if (derivative.middleRows(r, 2).allFinite() && rigid.middleRows(r, 2).allFinite()) rows.insert(rows.end(), {r, r + 1});
+  if (rows.size() <= 2 * static_cast<size_t>(rigid.cols())) return false;
+  Eigen::MatrixXd kept_rigid(rows.size(), rigid.cols()), kept_derivative(rows.size(), derivative.cols());
+  for (size_t r = 0; r < rows.size(); ++r) {
+    kept_rigid.row(r) = rigid.row(rows[r]);
+    kept_derivative.row(r) = derivative.row(rows[r]);
+  }
+  // Turns in rad and shifts in mm move pixels on other scales: solved on unit columns.
+  const Eigen::VectorXd scale = kept_rigid.colwise().norm().transpose();
+  const Eigen::MatrixXd unit = kept_rigid * scale.cwiseInverse().asDiagonal();
+  *motion = scale.cwiseInverse().asDiagonal() * unit.colPivHouseholderQr().solve(kept_derivative);
+  return true;
+}
+
 }  // namespace
 
 void MedianAndMax(std::vector<double> values, double* median, double* max) {
@@ -142,7 +161,7 @@ std::vector<Eigen::Vector2d> FieldPixels(const Sensor& sensor, const ObservedFie
 
 std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const FitResult& fit,
                                                    const std::vector<Eigen::Vector2d>& pixels,
-                                                   const std::vector<double>& distances_mm) {
+                                                   const std::vector<double>& distances_mm, double align_at_mm) {
   if (!fit.covariance_ok || fit.covariance.rows() != static_cast<int>(fit.covariance_names.size()))
     throw std::invalid_argument("PredictProjectionError: the fit has no covariance");
   // 5 % wider: a parameter step must not push the outermost field pixels' reflections
@@ -159,15 +178,13 @@ std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const F
     index.push_back(static_cast<size_t>(found - named.begin()));
   }
   const int count = static_cast<int>(index.size());
-  std::vector<PredictedError> maps;
-  for (double distance_mm : distances_mm) {
-    const Eigen::Matrix3Xd points = PointsAt(sensor, pixels, distance_mm);
-    // d pixel / d parameter by central differences, a hundredth of a std each way. A tenth
-    // reached into the projection's curvature where a std is large (a near-sphere's tilt,
-    // 35 deg): worst 0.136 px at 338 mm against 0.089 with a hundredth or a thousandth
-    // (those agree to 3 digits), and 27 field pixels stepped past the rim. The solvers'
-    // 1e-10 px stays far below the ~1e-4 px differences.
-    Eigen::MatrixXd derivative(2 * pixels.size(), count);  // rows x0, y0, x1, y1, ...
+  // d pixel / d parameter at the points, by central differences, a hundredth of a std
+  // each way. A tenth reached into the projection's curvature where a std is large (a
+  // near-sphere's tilt, 35 deg): worst 0.136 px at 338 mm against 0.089 with a hundredth
+  // or a thousandth (those agree to 3 digits), and 27 field pixels stepped past the rim.
+  // The solvers' 1e-10 px stays far below the ~1e-4 px differences.
+  const auto parameter_fields = [&](const Eigen::Matrix3Xd& points) {
+    Eigen::MatrixXd derivative(2 * points.cols(), count);  // rows x0, y0, x1, y1, ...
     for (int k = 0; k < count; ++k) {
       const double std_k = std::sqrt(std::max(0.0, fit.covariance(k, k)));
       const double step = std::max(0.01 * std_k, 1e-9 * (1.0 + std::abs(values[index[k]])));
@@ -179,33 +196,42 @@ std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const F
           (2.0 * step);
       derivative.col(k) = Eigen::Map<const Eigen::VectorXd>(moved.data(), moved.size());
     }
+    return derivative;
+  };
+  // One rigid motion per parameter direction, fitted at align_at_mm and applied at every
+  // distance (calib/projection_diff.h): its coefficients on the rigid generators. Where
+  // too few field pixels project there, each distance is aligned on its own.
+  bool align_once = !std::isnan(align_at_mm);
+  Eigen::MatrixXd motion_per_parameter;
+  if (align_once) {
+    const Eigen::Matrix3Xd points = PointsAt(sensor, pixels, align_at_mm);
+    align_once = FitRigidMotion(RigidMotionFields(wide, points, align_at_mm < kInfinityMm), parameter_fields(points),
+                                &motion_per_parameter);
+  }
+  std::vector<PredictedError> maps;
+  for (double distance_mm : distances_mm) {
+    const Eigen::Matrix3Xd points = PointsAt(sensor, pixels, distance_mm);
+    Eigen::MatrixXd derivative = parameter_fields(points);
     PredictedError map;
     map.in_camera_frame_std_px.resize(pixels.size());
     for (size_t p = 0; p < pixels.size(); ++p)
       map.in_camera_frame_std_px[p] = StdOf(derivative.middleRows(2 * p, 2), fit.covariance);
-    // Less what a rigid motion of the frame explains, least squares over the pixels that
-    // predict (at infinity a translation moves nothing: rotation only), as diff aligns.
-    const Eigen::MatrixXd rigid = RigidMotionFields(wide, points, distance_mm < kInfinityMm);
-    std::vector<Eigen::Index> rows;
-    for (size_t p = 0; p < pixels.size(); ++p)
-      if (derivative.middleRows(2 * p, 2).allFinite() && rigid.middleRows(2 * p, 2).allFinite())
-        rows.insert(rows.end(), {static_cast<Eigen::Index>(2 * p), static_cast<Eigen::Index>(2 * p + 1)});
+    // Less what a rigid motion of the frame explains (at infinity a translation moves
+    // nothing: rotation only), as diff aligns: fitted here by least squares over the
+    // pixels that predict, or the one fitted at align_at_mm.
+    const Eigen::MatrixXd rigid =
+        RigidMotionFields(wide, points, align_once ? motion_per_parameter.rows() == 6 : distance_mm < kInfinityMm);
+    Eigen::MatrixXd motion = motion_per_parameter;
     // A pixel the alignment could not weigh (its rigid motion does not project, or too few
     // do) has no aligned figure.
-    const bool alignable = rows.size() > 2 * static_cast<size_t>(rigid.cols());
+    const bool alignable = align_once || FitRigidMotion(rigid, derivative, &motion);
     std::vector<bool> aligned(pixels.size(), false);
-    for (size_t r = 0; alignable && r < rows.size(); r += 2) aligned[rows[r] / 2] = true;
-    if (alignable) {
-      Eigen::MatrixXd kept_rigid(rows.size(), rigid.cols()), kept_derivative(rows.size(), count);
-      for (size_t r = 0; r < rows.size(); ++r) {
-        kept_rigid.row(r) = rigid.row(rows[r]);
-        kept_derivative.row(r) = derivative.row(rows[r]);
-      }
-      kept_rigid.colwise().normalize();  // turns in rad and shifts in mm move pixels on other scales
-      const Eigen::MatrixXd explained = kept_rigid * kept_rigid.colPivHouseholderQr().solve(kept_derivative);
-      for (size_t r = 0; r < rows.size(); ++r) derivative.row(rows[r]) -= explained.row(r);
+    for (size_t p = 0; alignable && p < pixels.size(); ++p) {
+      aligned[p] = derivative.middleRows(2 * p, 2).allFinite() && rigid.middleRows(2 * p, 2).allFinite();
+      if (aligned[p]) derivative.middleRows(2 * p, 2) -= rigid.middleRows(2 * p, 2) * motion;
     }
     map.distance_mm = distance_mm;
+    map.aligned_at_mm = !alignable ? NAN : align_once ? align_at_mm : distance_mm;
     map.pixels = pixels;
     map.std_px.resize(pixels.size());
     for (size_t p = 0; p < pixels.size(); ++p) {

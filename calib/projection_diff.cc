@@ -99,6 +99,29 @@ class AlignmentCost : public ceres::CostFunction {
   Eigen::Matrix2Xd targets_px_;
 };
 
+// The reference's points distance_mm along the pixels' rays (columns of *points) and the
+// pixels (*kept_pixels) where both sensors project them; returns their indices.
+std::vector<size_t> PointsBothProject(const Sensor& reference, const Sensor& other, const std::vector<Eigen::Vector2d>& pixels,
+                                      double distance_mm, Eigen::Matrix3Xd* points, Eigen::Matrix2Xd* kept_pixels) {
+  Eigen::Matrix2Xd grid(2, pixels.size());
+  for (size_t k = 0; k < pixels.size(); ++k) grid.col(k) = pixels[k];
+  Eigen::Matrix3Xd origins, directions;
+  std::vector<ProjectionStatus> unprojected;
+  reference.UnprojectBatch(grid, &origins, &directions, &unprojected);
+  const Eigen::Matrix3Xd all = origins + distance_mm * directions;
+  Eigen::Matrix2Xd through_other;
+  std::vector<ProjectionStatus> projected;
+  other.ProjectBatch(all, &through_other, &projected);
+  std::vector<size_t> kept;
+  for (size_t k = 0; k < pixels.size(); ++k)
+    if (unprojected[k] == ProjectionStatus::kOk && projected[k] == ProjectionStatus::kOk && all.col(k).allFinite())
+      kept.push_back(k);
+  points->resize(3, kept.size());
+  kept_pixels->resize(2, kept.size());
+  for (size_t i = 0; i < kept.size(); ++i) points->col(i) = all.col(kept[i]), kept_pixels->col(i) = pixels[kept[i]];
+  return kept;
+}
+
 }  // namespace
 
 std::vector<Eigen::Vector2d> ComparisonField(const Sensor& reference, const DetectionSet* detections, double step_px) {
@@ -119,35 +142,20 @@ std::vector<Eigen::Vector2d> ComparisonField(const Sensor& reference, const Dete
 }
 
 ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, const std::vector<Eigen::Vector2d>& pixels,
-                                  double distance_mm, bool align) {
+                                  double distance_mm, bool align, double align_at_mm) {
   if (const std::string why = ObjectDistanceProblem(distance_mm); !why.empty()) throw InputError("distance_mm: " + why);
+  const double fit_at_mm = std::isnan(align_at_mm) ? distance_mm : align_at_mm;
+  if (const std::string why = ObjectDistanceProblem(fit_at_mm); align && !why.empty()) throw InputError("align_at_mm: " + why);
   ProjectionDiff diff;
   diff.distance_mm = distance_mm;
   diff.pixels = pixels;
   diff.difference_px.assign(pixels.size(), Eigen::Vector2d::Constant(NAN));
-  // The reference's points, and which of them both sensors project.
-  std::vector<size_t> kept;
-  Eigen::Matrix3Xd points(3, pixels.size());
-  {
-    Eigen::Matrix2Xd grid(2, pixels.size());
-    for (size_t k = 0; k < pixels.size(); ++k) grid.col(k) = pixels[k];
-    Eigen::Matrix3Xd origins, directions;
-    std::vector<ProjectionStatus> unprojected;
-    reference.UnprojectBatch(grid, &origins, &directions, &unprojected);
-    points = origins + distance_mm * directions;
-    Eigen::Matrix2Xd through_other;
-    std::vector<ProjectionStatus> projected;
-    other.ProjectBatch(points, &through_other, &projected);
-    for (size_t k = 0; k < pixels.size(); ++k)
-      if (unprojected[k] == ProjectionStatus::kOk && projected[k] == ProjectionStatus::kOk && points.col(k).allFinite())
-        kept.push_back(k);
-  }
+  Eigen::Matrix3Xd kept_points;
+  Eigen::Matrix2Xd kept_pixels;
+  const std::vector<size_t> kept = PointsBothProject(reference, other, pixels, distance_mm, &kept_points, &kept_pixels);
   if (kept.size() < 6)
     throw InputError("field: only " + std::to_string(kept.size()) +
                      " field pixels project through both calibrations (need >= 6): are they of the same camera?");
-  Eigen::Matrix3Xd kept_points(3, kept.size());
-  Eigen::Matrix2Xd kept_pixels(2, kept.size());
-  for (size_t i = 0; i < kept.size(); ++i) kept_points.col(i) = points.col(kept[i]), kept_pixels.col(i) = pixels[kept[i]];
 
   double angle_axis[3] = {0.0, 0.0, 0.0}, translation[3] = {0.0, 0.0, 0.0};
   // The alignment's steps (and its central differences) move points at the rim a little
@@ -158,10 +166,16 @@ ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, 
   MovedPixels(wide, kept_points, angle_axis, translation, &before);
   diff.unaligned_rms_px = std::sqrt((before - kept_pixels).colwise().squaredNorm().mean());
   if (align) {
+    Eigen::Matrix3Xd fit_points = kept_points;
+    Eigen::Matrix2Xd fit_pixels = kept_pixels;
+    if (fit_at_mm != distance_mm &&
+        PointsBothProject(reference, other, pixels, fit_at_mm, &fit_points, &fit_pixels).size() < 6)
+      throw InputError("align_at_mm: only " + std::to_string(fit_points.cols()) +
+                       " field pixels project through both calibrations at that distance (need >= 6)");
     ceres::Problem problem;
-    problem.AddResidualBlock(new AlignmentCost(wide, kept_points, kept_pixels), nullptr, angle_axis, translation);
+    problem.AddResidualBlock(new AlignmentCost(wide, fit_points, fit_pixels), nullptr, angle_axis, translation);
     // At infinity a translation moves no point: only the rotation is determined.
-    if (distance_mm >= kInfinityMm) problem.SetParameterBlockConstant(translation);
+    if (fit_at_mm >= kInfinityMm) problem.SetParameterBlockConstant(translation);
     ceres::Solver::Options options;
     options.linear_solver_type = ceres::DENSE_QR;
     options.max_num_iterations = 100;
@@ -171,15 +185,14 @@ ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, 
     ceres::Solver::Summary summary;
     ceres::Solve(options, &problem, &summary);
     diff.aligned = summary.IsSolutionUsable();
-    if (!diff.aligned) angle_axis[0] = angle_axis[1] = angle_axis[2] = translation[0] = translation[1] = translation[2] = 0.0;
+    if (diff.aligned) diff.aligned_at_mm = fit_at_mm;
+    else angle_axis[0] = angle_axis[1] = angle_axis[2] = translation[0] = translation[1] = translation[2] = 0.0;
   }
+  // Fitted at the compared distance, every moved point projects (the solver takes no step
+  // where one does not); fitted elsewhere, a point moved past the rim is not compared.
   Eigen::Matrix2Xd after;
-  if (!MovedPixels(wide, kept_points, angle_axis, translation, &after)) {
-    // Unreachable in practice (the solver only accepts steps where every point projects).
-    after = before;
-    diff.aligned = false;
-    angle_axis[0] = angle_axis[1] = angle_axis[2] = translation[0] = translation[1] = translation[2] = 0.0;
-  }
+  std::vector<ProjectionStatus> after_status;
+  MovedPixels(wide, kept_points, angle_axis, translation, &after, &after_status);
   const Eigen::Vector3d rotation_vector(angle_axis[0], angle_axis[1], angle_axis[2]);
   diff.rotation_deg = rotation_vector.norm() * 180.0 / M_PI;
   diff.rotation = rotation_vector.norm() > 0.0 ? Eigen::Quaterniond(Eigen::AngleAxisd(rotation_vector.norm(), rotation_vector.normalized()))
@@ -188,13 +201,14 @@ ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, 
   std::vector<double> lengths;
   double square = 0.0;
   for (size_t i = 0; i < kept.size(); ++i) {
+    if (after_status[i] != ProjectionStatus::kOk) continue;
     const Eigen::Vector2d d = after.col(i) - kept_pixels.col(i);
     diff.difference_px[kept[i]] = d;
     lengths.push_back(d.norm());
     square += d.squaredNorm();
   }
-  diff.compared = static_cast<int>(kept.size());
-  diff.rms_px = std::sqrt(square / kept.size());
+  diff.compared = static_cast<int>(lengths.size());
+  diff.rms_px = diff.compared > 0 ? std::sqrt(square / diff.compared) : NAN;
   MedianAndMax(lengths, &diff.median_px, &diff.max_px);
   return diff;
 }

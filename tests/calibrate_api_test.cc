@@ -105,7 +105,11 @@ TEST(CalibrateApi, ExactCornersRecoverTheRenderedSensorAndWarnAsTyped) {
   int high = 0;
   for (const CalibrationWarning& w : result.warnings) high += w.code == WarningCode::kPredictedErrorHigh;
   EXPECT_EQ(high, static_cast<int>(result.predicted.size()));
-  EXPECT_EQ(result.predicted.size(), 2u);  // the boards' median distance and infinity
+  ASSERT_EQ(result.predicted.size(), 2u);  // the boards' median distance and infinity
+  // One alignment for both, fitted at the first: the boards' median distance.
+  EXPECT_EQ(result.predicted[0].aligned_at_mm, result.predicted[0].distance_mm);
+  EXPECT_EQ(result.predicted[1].aligned_at_mm, result.predicted[0].distance_mm);
+  EXPECT_EQ(result.record.predicted_error[1].aligned_at_mm, result.predicted[0].distance_mm);
   EXPECT_EQ(result.record.warnings.size(), result.warnings.size());
 }
 
@@ -129,15 +133,22 @@ TEST(CalibrateApi, RecordRoundTripsThroughCalibrationJson) {
   EXPECT_EQ(back.predicted_error[0].max_px, result.record.predicted_error[0].max_px);
   EXPECT_TRUE(std::isfinite(result.record.predicted_error[0].in_camera_frame_max_px));
   EXPECT_EQ(back.predicted_error[0].in_camera_frame_max_px, result.record.predicted_error[0].in_camera_frame_max_px);
+  // Asked at n = 7 only, the alignment is still fitted where the boards were.
+  const double aligned_at_mm = result.record.predicted_error[0].aligned_at_mm;
+  EXPECT_GE(aligned_at_mm, result.record.nearest_target_mm);
+  EXPECT_LE(aligned_at_mm, result.record.farthest_target_mm);
+  EXPECT_EQ(back.predicted_error[0].aligned_at_mm, aligned_at_mm);
   {
     // A file from before the aligned prediction: its figures were the camera frame's.
     nlohmann::json old = nlohmann::json::parse(CalibrationJsonText(result.record));
-    for (auto& p : old["predicted_error"]) p.erase("in_camera_frame_median_px"), p.erase("in_camera_frame_max_px");
+    for (auto& p : old["predicted_error"])
+      p.erase("in_camera_frame_median_px"), p.erase("in_camera_frame_max_px"), p.erase("aligned_at_mm");
     std::ofstream(path) << old.dump();
     const CalibrationRecord relabelled = ReadCalibrationJson(path);
     std::filesystem::remove(path);
     EXPECT_EQ(relabelled.predicted_error[0].in_camera_frame_max_px, result.record.predicted_error[0].max_px);
     EXPECT_TRUE(std::isnan(relabelled.predicted_error[0].max_px));
+    EXPECT_TRUE(std::isnan(relabelled.predicted_error[0].aligned_at_mm));
   }
   // A knot choice (its numbers set here: choosing takes 30 fits) with a failed candidate.
   CalibrationRecord chosen = result.record;

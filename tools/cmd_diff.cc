@@ -17,7 +17,7 @@ namespace {
 
 struct DiffFlags {
   std::string a, b, field_path, out_dir;
-  double distance_mm = 2000.0, step_px = 16.0;
+  double distance_mm = 2000.0, step_px = 16.0, align_at_mm = NAN;
   bool no_align = false;
 };
 
@@ -41,11 +41,12 @@ void RunDiff(const DiffFlags& options, const Context& context) {
     field_name = (std::filesystem::path(options.a) / "detections.json").string();
   std::optional<DetectionSet> detections;
   if (!field_name.empty()) detections = ReadDetections(field_name);
-  const FlagTable flags = FlagsOf({"distance_mm", "step_px"});
+  const FlagTable flags = FlagsOf({"distance_mm", "step_px", "align_at_mm"});
   const std::vector<Eigen::Vector2d> field =
       NamingFlags(flags, [&] { return ComparisonField(a, detections ? &*detections : nullptr, options.step_px); });
   const ProjectionDiff diff =
-      NamingFlags(flags, [&] { return CompareProjections(a, b, field, options.distance_mm, !options.no_align); });
+      NamingFlags(flags, [&] { return CompareProjections(a, b, field, options.distance_mm, !options.no_align,
+                                                         options.align_at_mm); });
   const std::string field_label = field_name.empty() ? "every pixel of the mirror" : "the corners' annulus in " + field_name;
   if (!options.out_dir.empty()) {
     const std::filesystem::path dir(options.out_dir);
@@ -59,8 +60,10 @@ void RunDiff(const DiffFlags& options, const Context& context) {
   if (context.quiet) return;
   std::printf("at %.0f mm over %d pixels (%s): RMS %.4f px, median %.4f px, max %.4f px\n", options.distance_mm,
               diff.compared, field_label.c_str(), diff.rms_px, diff.median_px, diff.max_px);
+  char fitted[64];
+  std::snprintf(fitted, sizeof fitted, "fitted at %.0f mm", diff.aligned_at_mm);
   std::printf("alignment: %s, rotation %.4f deg, translation (%.3f, %.3f, %.3f) mm; before it: RMS %.4f px\n",
-              diff.aligned        ? "fitted"
+              diff.aligned        ? fitted
               : options.no_align ? "none (--no-align)"
                                  : "FAILED (the numbers are unaligned)",
               diff.rotation_deg, diff.translation_mm.x(), diff.translation_mm.y(),
@@ -83,7 +86,11 @@ Command DiffCommand() {
                            "detections.json, else every pixel of the mirror)");
             sub.add_option("--step-px", options->step_px, "Grid step of the compared pixels")
                 ->check(CLI::Range(1.0, 1000.0))->capture_default_str();
-            sub.add_flag("--no-align", options->no_align, "Compare without the rigid alignment");
+            sub.add_option("--align-at-mm", options->align_at_mm,
+                           "Fit the rigid alignment at this distance (e.g. the boards') and apply it at --distance-mm "
+                           "(default: fitted at --distance-mm)")
+                ->check(kPositive);
+            sub.add_flag("--no-align", options->no_align, "Compare without the rigid alignment")->excludes("--align-at-mm");
             sub.add_option("--out", options->out_dir, "Output directory for diff.json and diff.png");
             return [options, &context]() { RunDiff(*options, context); };
           }};

@@ -36,8 +36,13 @@ void WritePredictedErrorMap(const std::string& path, const Sensor& sensor, const
   std::snprintf(text, sizeof text, "predicted error at %s: median %.3f px, worst %.3f px", label.c_str(), map.median_px,
                 map.max_px);
   cv::putText(picture, text, {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
-  cv::putText(picture, "after the best rigid alignment of the frame, as omnical diff", {10, 48},
-              cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  if (std::isfinite(map.aligned_at_mm)) {
+    std::snprintf(text, sizeof text, "after the rigid alignment fitted at %.0f mm, as omnical diff --align-at-mm",
+                  map.aligned_at_mm);
+  } else {
+    std::snprintf(text, sizeof text, "after the best rigid alignment at this distance, as omnical diff");
+  }
+  cv::putText(picture, text, {10, 48}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   std::snprintf(text, sizeof text, "colour: 0 (purple) to %.3f px (yellow); warning above %.2f px", top, threshold_px);
   cv::putText(picture, text, {10, 70}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   WritePng(path, picture);

@@ -341,6 +341,8 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
     assert close(held["training_rms_px"], result.rms_all_px)
     assert [list(h) for h in cross["halves"]] == cli["cross_validation"]["halves"]
     assert close(cross["rms_px"], cli["cross_validation"]["diff_rms_px"]) and cross["distance_mm"] == 1500
+    boards, cli_boards = cross["aligned_at_boards"], cli["cross_validation"]["aligned_at_boards"]
+    assert close(boards["rms_px"], cli_boards["diff_rms_px"]) and close(boards["aligned_at_mm"], cli_boards["aligned_at_mm"])
     assert omnical.load_calibration(tmp_path / "cli" / "calibration.json").holdout["views"] == held["views"]
     warp = result.board_warp
     assert close(warp["x_mm"], cli["board_warp"]["x_mm"]) and close(warp["std_y_mm"], cli["board_warp"]["std_y_mm"])
@@ -364,7 +366,17 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
     assert cli_diff["grid_points"] - 1 <= mine["compared"] <= cli_diff["grid_points"] <= len(cli_diff["pixels"])
     assert mine["pixels"].shape == mine["difference_px"].shape == (len(cli_diff["pixels"]), 2)
     same = omnical.diff(result.sensor, result.sensor, distance_mm=1500)
-    assert same["rms_px"] < 1e-7 and same["compared"] > 100
+    assert same["rms_px"] < 1e-7 and same["compared"] > 100 and same["aligned_at_mm"] == 1500
+    # One alignment fitted where the boards were, carried to 1500 mm: as the CLI's --align-at-mm.
+    done = run_cli("-q", "diff", runs.out / "cli", tmp_path / "cli", "--field", detections, "--distance-mm", 1500,
+                   "--align-at-mm", 400, "--out", tmp_path / "diff400")
+    assert done.returncode == 0, done.stderr
+    cli_once = json.loads((tmp_path / "diff400" / "diff.json").read_text())
+    once = omnical.diff(runs.out / "cli", tmp_path / "cli" / "sensor.yaml", distance_mm=1500, field=detections,
+                        align_at_mm=400)
+    assert once["aligned_at_mm"] == cli_once["aligned_at_mm"] == 400 and cli_diff["aligned_at_mm"] == 1500
+    for key in ("rms_px", "median_px", "max_px"):
+        assert close(once[key], cli_once["diff_" + key]), key
 
     # A spline mirror with a set knot count; bad counts with the CLI's message.
     spline = omnical.calibrate(TARGET, detections=detections, guess=GUESS, profile="spline", knots=4,
@@ -394,6 +406,10 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
         omnical.diff(result.sensor, result.sensor, distance_mm=0)
     with pytest.raises(omnical.InputError, match="field: expected"):
         omnical.diff(result.sensor, result.sensor, field=3)
+    too_far = cli_error(run_cli("diff", runs.out / "cli", runs.out / "cli", "--align-at-mm", "1e9"))
+    with pytest.raises(omnical.InputError) as raised:
+        omnical.diff(result.sensor, result.sensor, align_at_mm=1e9)
+    assert str(raised.value) == too_far.replace("--align-at-mm", "align_at_mm")
 
 
 def test_holdout_folds_equal_cli(runs, tmp_path):

@@ -161,7 +161,8 @@ py::dict PoseMatrices(const std::map<std::string, TargetPose>& poses) {
 py::dict DiffDict(const ProjectionDiff& d) {
   return py::dict("distance_mm"_a = d.distance_mm >= kInfinityMm ? HUGE_VAL : d.distance_mm, "rms_px"_a = d.rms_px,
                   "median_px"_a = d.median_px, "max_px"_a = d.max_px, "unaligned_rms_px"_a = d.unaligned_rms_px,
-                  "compared"_a = d.compared, "aligned"_a = d.aligned, "rotation_deg"_a = d.rotation_deg,
+                  "compared"_a = d.compared, "aligned"_a = d.aligned, "aligned_at_mm"_a = d.aligned_at_mm,
+                  "rotation_deg"_a = d.rotation_deg,
                   "translation_mm"_a = py::make_tuple(d.translation_mm.x(), d.translation_mm.y(), d.translation_mm.z()));
 }
 
@@ -313,10 +314,13 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
         py::dict out = DiffDict(c->diff);
         out["halves"] = py::make_tuple(c->halves[0], c->halves[1]);
         out["half_rms_px"] = py::make_tuple(c->half_rms_px[0], c->half_rms_px[1]);
+        out["aligned_at_boards"] = c->diff_aligned_at_boards ? py::object(DiffDict(*c->diff_aligned_at_boards)) : py::none();
         return out;
       },
       "The two halves' comparison (cross_validate=True): dict halves, half_rms_px, distance_mm, rms_px, median_px, "
-      "max_px, unaligned_rms_px, compared, aligned, rotation_deg, translation_mm; None unless asked.");
+      "max_px, unaligned_rms_px, compared, aligned, aligned_at_mm, rotation_deg, translation_mm, aligned_at_boards "
+      "(the same keys with one alignment fitted at the boards' median distance, as predicted_error; None where it "
+      "could not be); None unless asked.");
   cls.def_property_readonly(
       "predicted_error",
       [record](const Holder& holder) {
@@ -328,13 +332,15 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
                               "max_px"_a = p.max_px, "field_pixels"_a = p.field_pixels,
                               "unpredicted_pixels"_a = p.unpredicted_pixels,
                               "in_camera_frame_median_px"_a = p.in_camera_frame_median_px,
-                              "in_camera_frame_max_px"_a = p.in_camera_frame_max_px));
+                              "in_camera_frame_max_px"_a = p.in_camera_frame_max_px,
+                              "aligned_at_mm"_a = p.aligned_at_mm));
         }
         return out;
       },
       "The predicted projection error per distance: list of dicts (distance_mm (inf for infinity), n_rim_radii, "
-      "median_px, max_px (after the best rigid alignment, as diff), field_pixels, unpredicted_pixels, "
-      "in_camera_frame_median_px, in_camera_frame_max_px (points held in the camera's frame)).");
+      "median_px, max_px (after the rigid alignment fitted at aligned_at_mm, the boards' median distance, as "
+      "diff(align_at_mm=...)), field_pixels, unpredicted_pixels, in_camera_frame_median_px, in_camera_frame_max_px "
+      "(points held in the camera's frame), aligned_at_mm (nan: fitted at each distance, an older file)).");
   cls.def(
       "to_json", [record](const Holder& holder) { return CalibrationJsonText(record(holder)); },
       "The text of calibration.json.");
@@ -772,7 +778,7 @@ Raises InputError with the library's message (too few views, a bad file, a bad v
   m.def(
       "diff",
       [](const py::object& a, const py::object& b, double distance_mm, const py::object& field, double step_px,
-         bool align) {
+         bool align, const std::optional<double>& align_at_mm) {
         // A Sensor, a sensor file, or calibrate's output directory (its sensor.yaml).
         const auto sensor_of = [](const py::object& given, const char* name) {
           if (py::isinstance<Sensor>(given)) return given.cast<Sensor>();
@@ -794,7 +800,7 @@ Raises InputError with the library's message (too few views, a bad file, a bad v
         }
         const ProjectionDiff diff = RunReleased([&] {
           return CompareProjections(reference, other, ComparisonField(reference, detections ? &*detections : nullptr, step_px),
-                                    distance_mm, align);
+                                    distance_mm, align, align_at_mm.value_or(NAN));
         });
         py::dict out = DiffDict(diff);
         out["pixels"] = PointsArray(diff.pixels);
@@ -802,16 +808,20 @@ Raises InputError with the library's message (too few views, a bad file, a bad v
         return out;
       },
       "a"_a, "b"_a, py::kw_only(), "distance_mm"_a = 2000.0, "field"_a = py::none(), "step_px"_a = 16.0,
-      "align"_a = true,
+      "align"_a = true, "align_at_mm"_a = py::none(),
       R"(Compares two calibrations of one camera (as `omnical diff`) -> dict.
 
 a, b: a Sensor, a sensor file or calibrate's output directory. The points distance_mm
 along each field pixel's ray through a (from its reflection point; a large value such as
 1e8 for infinity), moved by the rigid motion that best aligns them (align=False: none),
-projected through b. field: Detections or a detections file whose corners' annulus is
-compared, None for every pixel of a's mirror; step_px apart. Returns rms_px, median_px,
-max_px, unaligned_rms_px, compared, aligned, rotation_deg, translation_mm, distance_mm,
-pixels (N, 2) and difference_px (N, 2; NaN where either does not project).)");
+projected through b. That motion is fitted at distance_mm, or at align_at_mm and applied
+at distance_mm (one motion for a scene that spans distances: align_at_mm the boards'
+distance, as calibrate's predicted_error). field: Detections or a detections file whose
+corners' annulus is compared, None for every pixel of a's mirror; step_px apart. Returns
+rms_px, median_px, max_px, unaligned_rms_px, compared, aligned, aligned_at_mm,
+rotation_deg, translation_mm, distance_mm, pixels (N, 2) and difference_px (N, 2; NaN
+where either does not project or, aligned elsewhere, the moved point falls off b's
+mirror).)");
 }
 
 }  // namespace

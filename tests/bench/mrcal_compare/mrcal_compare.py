@@ -70,7 +70,11 @@ DEFINITIONS = [
     "centre, is the camera's own reflection here). Observed field: the annulus of radii the corners cover "
     "around the projection centre, all round, on a 16 px grid. The mrcal details add the same figure over "
     "the grid points within 24 px of a corner of each half (both calibrations have data there; aligned over "
-    "those points): what is left when neither model extrapolates.",
+    "those points): what is left when neither model extrapolates. The per-dataset lines add the halves with one "
+    "rigid motion fitted over the field at the boards' median distance and applied at "
+    f"{DISTANCE_MM / 1000:g} m (omnical: `cross_validation.aligned_at_boards`, as its predicted error is taken; "
+    "mrcal: the implied transform fitted at that distance): fitted at the compared distance itself, the "
+    "alignment's translation grows with the distance and takes up a zoom-like disagreement no pose could absorb.",
     "- **mrcal's solve** follows mrcal-calibrate-cameras v2.2 (`solve_initial` and the final solve; "
     "`tests/bench/mrcal_compare/mrcal_fit.py`): a LENSMODEL_STEREOGRAPHIC seed (a central paraboloid is exactly "
     "stereographic, and this field passes 90 deg off the axis, which a pinhole or OpenCV model cannot hold), "
@@ -207,6 +211,10 @@ def omnical_side(dataset, cli, out, log):
         halves = [sorted(index_of(names, half)) for half in cross["halves"]]
         row["halves"] = dict(diff_rms_px=float(cross["diff_rms_px"]), diff_max_px=float(cross["diff_max_px"]),
                              half_rms_px=[float(v) for v in cross.get("half_rms_px", [])])
+        if cross.get("aligned_at_boards"):  # omnical after 2026-11-29: one alignment fitted at the boards
+            boards = cross["aligned_at_boards"]
+            row["halves"].update(boards_diff_rms_px=float(boards["diff_rms_px"]),
+                                 boards_diff_max_px=float(boards["diff_max_px"]), boards_mm=float(boards["aligned_at_mm"]))
     elif cli.has_diff:
         log(f"{dataset.name}: omnical calibrate per half, omnical diff")
         fits = []
@@ -266,8 +274,10 @@ def mrcal_side(dataset, omni, knots, log):
         rms, _, per_view = mrcal_fit.held_out_rms(trained, observed[held])
         row["holdout"] = dict(rms_px=rms, per_view_px=per_view)
         fits = [mrcal_fit.splined_fit(cores[tuple(half)], lensmodel) for half in halves]
+        boards_mm = (omni["row"].get("halves") or {}).get("boards_mm")
         row["halves"] = mrcal_fit.halves_diff(fits[0][0], fits[1][0], DISTANCE_MM / 1000.0, centre, field,
-                                              *[observed[half][seen[half]][:, :2] for half in halves])
+                                              *[observed[half][seen[half]][:, :2] for half in halves],
+                                              align_at_m=boards_mm / 1000.0 if boards_mm else None)
         row["halves"]["half_rms_px"] = [mrcal_fit.fit_summary(p, s, observed[half])["rms_inliers_px"]
                                         for (p, s), half in zip(fits, halves)]
         rows.append(row)
@@ -462,9 +472,16 @@ def write_document(path, results, cli, quick, checkerboard_subpixel, seconds):
         halves_fit = [f"mrcal {r['knots']}: {joined(r['halves']['half_rms_px'])}" for r in mrcal_rows]
         if omni.get("halves") and omni["halves"].get("half_rms_px"):
             halves_fit.insert(0, f"omnical: {joined(omni['halves']['half_rms_px'])}")
+        boards = ""
+        if omni.get("halves") and omni["halves"].get("boards_mm"):
+            per_tool = [f"omnical {pair(omni['halves'], 'boards_diff_rms_px', 'boards_diff_max_px')}"]
+            per_tool += [f"mrcal {r['knots']}: {pair(r['halves'], 'boards_diff_rms_px', 'boards_diff_max_px')}"
+                         for r in mrcal_rows]
+            boards = (f"halves at {DISTANCE_MM / 1000:g} m with one alignment fitted at the boards' "
+                      f"{omni['halves']['boards_mm']:.0f} mm, RMS / max: {'; '.join(per_tool)} px; ")
         out.append(f"- {result['dataset'].name}: {result['corners']} corners; held out {', '.join(views)}; "
                    f"halves of {result['halves'][0]} and {result['halves'][1]} views, fit to {'; '.join(halves_fit)} px; "
-                   f"observed field r = {result['field'][0]:.0f}-{result['field'][1]:.0f} px around "
+                   f"{boards}observed field r = {result['field'][0]:.0f}-{result['field'][1]:.0f} px around "
                    f"({result['centre'][0]:.1f}, {result['centre'][1]:.1f}), corners up to "
                    f"{result['theta_deg']:.1f} deg off the stereographic axis.")
     out += ["", "mrcal details (full-set fits):", "",

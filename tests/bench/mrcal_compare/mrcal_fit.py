@@ -258,13 +258,15 @@ def _gap_px(grid, corners_px):
 
 
 def halves_diff(problem_a, problem_b, distance_m, centre_px, radius_range_px, corners_a_px, corners_b_px,
-                step_px=16.0, near_px=24.0, min_points=10):
+                step_px=16.0, near_px=24.0, min_points=10, align_at_m=None):
     """mrcal.projection_diff of two fits at `distance_m` over the observed field, the
     implied transform between the two camera frames fitted over that field
     (projection_diff's default focus, a disc at the imager centre, is the camera's own
     reflection here: no data). The near_* figures: the grid points within `near_px` of a
     corner of each half (both calibrations have data there), aligned over those points;
-    None when fewer than `min_points`."""
+    None when fewer than `min_points`. The boards_* figures (with `align_at_m`): the
+    transform fitted over the field at that distance (the boards') and applied at
+    `distance_m`, as omnical's cross_validation.aligned_at_boards."""
     models = [mrcal.cameramodel(optimization_inputs=p, icam_intrinsics=0) for p in (problem_a, problem_b)]
     width, height = models[0].imagersize()
     columns = int(round((width - 1) / step_px)) + 1
@@ -275,11 +277,14 @@ def halves_diff(problem_a, problem_b, distance_m, centre_px, radius_range_px, co
     inside = field_mask(grid, centre_px, radius_range_px)
     both = inside & (_gap_px(grid, corners_a_px) <= near_px) & (_gap_px(grid, corners_b_px) <= near_px)
     out = {}
-    for key, mask in (("", inside), ("near_", both)):
+    passes = [("", inside, distance_m), ("near_", both, distance_m)]
+    if align_at_m:
+        passes.append(("boards_", inside, align_at_m))
+    for key, mask, fit_at_m in passes:
         if np.count_nonzero(mask) < min_points:
             out.update({f"{key}diff_rms_px": None, f"{key}diff_max_px": None, f"{key}grid_points": 0})
             continue
-        implied = mrcal.implied_Rt10__from_unprojections(grid, rays[0] * distance_m, rays[1],
+        implied = mrcal.implied_Rt10__from_unprojections(grid, rays[0] * fit_at_m, rays[1],
                                                          weights=mask.astype(float), atinfinity=False)
         difflen = mrcal.projection_diff(models, implied_Rt10=implied, gridn_width=columns, gridn_height=rows,
                                         distance=distance_m, use_uncertainties=False)[0]

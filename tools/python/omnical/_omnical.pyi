@@ -356,7 +356,8 @@ def calibrate(target: Union[Target, _Path], images: Optional[_Images] = None, *,
               progress: _Progress = None) -> CalibrationResult: ...
 
 def diff(a: Union[Sensor, _Path], b: Union[Sensor, _Path], *, distance_mm: float = 2000.0,
-         field: Union[Detections, _Path, None] = None, step_px: float = 16.0, align: bool = True) -> Dict[str, object]: ...
+         field: Union[Detections, _Path, None] = None, step_px: float = 16.0, align: bool = True,
+         align_at_mm: Optional[float] = None) -> Dict[str, object]: ...
 
 # --- correction (bind_correction.cc)
 
