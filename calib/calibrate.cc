@@ -997,8 +997,8 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
                                             : !options.distances_n.empty() ? options.distances_n.front() * rim_mm
                                                                            : kDefaultCrossValidationDistanceMm;
     ProgressReporter progress(options.progress, "cross-validation", 1);
-    TwoHalves halves = CrossValidateHalves(fit_start, input.target, fitted_views, fitted_start_poses, fit_options, field,
-                                           distance_mm, boards_median_mm);
+    TwoHalves halves = CrossValidateHalves(fit_start, input.target, fitted_views, fitted_start_poses, fit_options,
+                                           field, distance_mm, boards_median_mm);
     progress.Step();
     record.cross_validation = CalibrationRecord::CrossValidationRecord{
         halves.images, halves.rms_px, std::move(halves.diff), std::move(halves.diff_aligned_at_boards)};
@@ -1026,7 +1026,8 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
       distance_labels.push_back(label);
       record.predicted_error.push_back({map.distance_mm, infinite ? HUGE_VAL : map.distance_mm / rim_mm, map.median_px, map.max_px,
                                         static_cast<int>(map.pixels.size()), map.unpredicted,
-                                        map.in_camera_frame_median_px, map.in_camera_frame_max_px, map.aligned_at_mm});
+                                        map.in_camera_frame_median_px, map.in_camera_frame_max_px,
+                                        map.aligned_once ? map.aligned_at_mm : NAN});
       if (!std::isfinite(map.max_px))
         warnings.push_back({WarningCode::kPredictedErrorUnknown, "",
                             std::string("the projection error at ") + label + " could not be predicted (no field pixel projects)"});

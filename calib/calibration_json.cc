@@ -63,9 +63,9 @@ const char* const kTangentialChoiceDefinition =
 const char* const kCrossValidationDefinition =
     "the usable views split into even and odd positions, each half calibrated alone; the points distance_mm along "
     "each observed field pixel's ray through half 1 (from its reflection point), moved by the rigid motion that "
-    "best aligns them, projected through half 2; diff_*_px are lengths of the 2-D pixel differences; aligned_at_boards: "
-    "the same with one rigid motion fitted at aligned_at_mm (the boards' median distance) and carried to distance_mm, "
-    "as the predicted error";
+    "best aligns them, projected through half 2; diff_*_px are lengths of the 2-D pixel differences; "
+    "aligned_at_boards: the same with one rigid motion fitted at aligned_at_mm (the boards' median distance) and "
+    "carried to distance_mm, as the predicted error";
 
 json NumberOrNull(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 double NumberOrNan(const json& value) { return value.is_null() ? NAN : value.get<double>(); }
@@ -99,6 +99,11 @@ json DistanceOrInfinity(double value, bool infinite) { return infinite ? json("i
 double ReadDistance(const json& value, double infinity) {
   return value.is_string() && value.get<std::string>() == "infinity" ? infinity : value.get<double>();
 }
+// Where an alignment was fitted: a distance, "infinity", or null (none).
+json AlignedAtJson(double aligned_at_mm) {
+  return std::isfinite(aligned_at_mm) ? DistanceOrInfinity(aligned_at_mm, aligned_at_mm >= kInfinityMm) : json(nullptr);
+}
+double ReadAlignedAt(const json& value) { return value.is_null() ? NAN : ReadDistance(value, kInfinityMm); }
 
 // The summary of a projection difference (calibration.json's cross_validation, diff.json).
 json DiffSummary(const ProjectionDiff& d) {
@@ -109,7 +114,8 @@ json DiffSummary(const ProjectionDiff& d) {
           {"unaligned_rms_px", NumberOrNull(d.unaligned_rms_px)},
           {"grid_points", d.compared},
           {"aligned", d.aligned},
-          {"aligned_at_mm", NumberOrNull(d.aligned_at_mm)},
+          {"aligned_at_mm", AlignedAtJson(d.aligned_at_mm)},
+          {"moved_off_mirror", d.moved_off_mirror},
           {"rotation_deg", d.rotation_deg},
           {"translation_mm", {d.translation_mm.x(), d.translation_mm.y(), d.translation_mm.z()}}};
 }
@@ -123,10 +129,11 @@ ProjectionDiff ReadDiffSummary(const json& c) {
   diff.max_px = NumberOrNan(c.at("diff_max_px"));
   diff.unaligned_rms_px = NumberOrNan(c.at("unaligned_rms_px"));
   diff.compared = c.at("grid_points").get<int>();
+  if (c.contains("moved_off_mirror")) diff.moved_off_mirror = c.at("moved_off_mirror").get<int>();
   diff.aligned = c.at("aligned").get<bool>();
   diff.rotation_deg = c.at("rotation_deg").get<double>();
   // Older files: an alignment was always fitted at the compared distance.
-  diff.aligned_at_mm = c.contains("aligned_at_mm") ? NumberOrNan(c.at("aligned_at_mm"))
+  diff.aligned_at_mm = c.contains("aligned_at_mm") ? ReadAlignedAt(c.at("aligned_at_mm"))
                        : diff.aligned              ? diff.distance_mm
                                                    : NAN;
   const json& t = c.at("translation_mm");
@@ -238,7 +245,7 @@ json ToJson(const CalibrationRecord& r) {
                                     {"unpredicted_pixels", p.unpredicted_pixels},
                                     {"in_camera_frame_median_px", NumberOrNull(p.in_camera_frame_median_px)},
                                     {"in_camera_frame_max_px", NumberOrNull(p.in_camera_frame_max_px)},
-                                    {"aligned_at_mm", NumberOrNull(p.aligned_at_mm)}});
+                                    {"aligned_at_mm", AlignedAtJson(p.aligned_at_mm)}});
   }
   if (r.covariance_ok) j["predicted_error_definition"] = kPredictedErrorDefinition;
   j["warnings"] = r.warnings;
@@ -381,7 +388,7 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
           summary.in_camera_frame_max_px = summary.max_px;
           summary.median_px = summary.max_px = NAN;
         }
-        if (p.contains("aligned_at_mm")) summary.aligned_at_mm = NumberOrNan(p.at("aligned_at_mm"));
+        if (p.contains("aligned_at_mm")) summary.aligned_at_mm = ReadAlignedAt(p.at("aligned_at_mm"));
         r.predicted_error.push_back(summary);
       }
     r.warnings = at("warnings").get<std::vector<std::string>>();
@@ -434,7 +441,9 @@ void WriteProjectionDiffJson(const ProjectionDiff& diff, const std::map<std::str
   for (const auto& [key, value] : labels) j[key] = value;
   j["definition"] =
       "the points distance_mm along each field pixel's ray through a (from its reflection point), moved by the rigid "
-      "motion that best aligns them, projected through b; differences are b's pixel minus the field pixel";
+      "motion that best aligns them (fitted at aligned_at_mm: distance_mm unless --align-at-mm was given), "
+      "projected through b; differences are b's pixel minus the field pixel; moved_off_mirror: field pixels whose "
+      "point that motion, fitted at another distance, moved off b's mirror (not compared)";
   for (size_t k = 0; k < diff.pixels.size(); ++k)
     j["pixels"].push_back({{"pixel", {diff.pixels[k].x(), diff.pixels[k].y()}},
                            {"difference_px", {NumberOrNull(diff.difference_px[k].x()), NumberOrNull(diff.difference_px[k].y())}}});

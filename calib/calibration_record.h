@@ -84,8 +84,9 @@ struct CalibrationRecord {
     double median_px = 0.0, max_px = 0.0;  // after the best rigid alignment (calib/predicted_error.h)
     int field_pixels = 0, unpredicted_pixels = 0;
     double in_camera_frame_median_px = NAN, in_camera_frame_max_px = NAN;  // the frame's own uncertainty kept
-    // Where the one rigid alignment was fitted (the boards' median distance); NaN: at each
-    // distance (files written before 2026-11-29's second change) or none.
+    // Where the one rigid alignment was fitted (the boards' median distance); NaN: fitted
+    // at each distance (files written before 2026-11-29's second change, or too few field
+    // pixels project at the boards' distance) or none.
     double aligned_at_mm = NAN;
   };
   std::vector<PredictedErrorSummary> predicted_error;

@@ -105,15 +105,17 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
                     "pixels (%s: %.3f deg, %.2f mm)\n",
                     cross->half_rms_px[0], cross->half_rms_px[1], cross->diff.distance_mm, cross->diff.rms_px,
                     cross->diff.max_px, cross->diff.compared,
-                    cross->diff.aligned ? "after the best rigid alignment" : "alignment FAILED, unaligned",
+                    cross->diff.aligned ? "after the best rigid alignment there" : "alignment FAILED, unaligned",
                     cross->diff.rotation_deg,
                     cross->diff.translation_mm.norm());
-  if (const auto& cross = record.cross_validation; cross && cross->diff_aligned_at_boards)
+  if (const auto& cross = record.cross_validation; cross && cross->diff_aligned_at_boards &&
+                                                     cross->diff_aligned_at_boards->aligned) {
+    const ProjectionDiff& once = *cross->diff_aligned_at_boards;
     AppendFormatted(out,
-                    "  with one rigid alignment fitted at the boards' %.0f mm (as the predicted error): %.4f px RMS, %.4f "
-                    "px max\n",
-                    cross->diff_aligned_at_boards->aligned_at_mm, cross->diff_aligned_at_boards->rms_px,
-                    cross->diff_aligned_at_boards->max_px);
+                    "  with one rigid alignment fitted at the boards' %.0f mm (as the predicted error): %.4f px RMS, "
+                    "%.4f px max over %d field pixels\n",
+                    once.aligned_at_mm, once.rms_px, once.max_px, once.compared);
+  }
   return out;
 }
 

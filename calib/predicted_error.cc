@@ -80,7 +80,8 @@ Eigen::MatrixXd RigidMotionFields(const Sensor& sensor, const Eigen::Matrix3Xd& 
 bool FitRigidMotion(const Eigen::MatrixXd& rigid, const Eigen::MatrixXd& derivative, Eigen::MatrixXd* motion) {
   std::vector<Eigen::Index> rows;
   for (Eigen::Index r = 0; r + 1 < rigid.rows(); r += 2)
-    if (derivative.middleRows(r, 2).allFinite() && rigid.middleRows(r, 2).allFinite()) rows.insert(rows.end(), {r, r + 1});
+    if (derivative.middleRows(r, 2).allFinite() && rigid.middleRows(r, 2).allFinite())
+      rows.insert(rows.end(), {r, r + 1});
   if (rows.size() <= 2 * static_cast<size_t>(rigid.cols())) return false;
   Eigen::MatrixXd kept_rigid(rows.size(), rigid.cols()), kept_derivative(rows.size(), derivative.cols());
   for (size_t r = 0; r < rows.size(); ++r) {
@@ -219,8 +220,8 @@ std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const F
     // Less what a rigid motion of the frame explains (at infinity a translation moves
     // nothing: rotation only), as diff aligns: fitted here by least squares over the
     // pixels that predict, or the one fitted at align_at_mm.
-    const Eigen::MatrixXd rigid =
-        RigidMotionFields(wide, points, align_once ? motion_per_parameter.rows() == 6 : distance_mm < kInfinityMm);
+    const bool with_translation = align_once ? align_at_mm < kInfinityMm : distance_mm < kInfinityMm;
+    const Eigen::MatrixXd rigid = RigidMotionFields(wide, points, with_translation);
     Eigen::MatrixXd motion = motion_per_parameter;
     // A pixel the alignment could not weigh (its rigid motion does not project, or too few
     // do) has no aligned figure.
@@ -232,6 +233,7 @@ std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const F
     }
     map.distance_mm = distance_mm;
     map.aligned_at_mm = !alignable ? NAN : align_once ? align_at_mm : distance_mm;
+    map.aligned_once = alignable && align_once;
     map.pixels = pixels;
     map.std_px.resize(pixels.size());
     for (size_t p = 0; p < pixels.size(); ++p) {

@@ -15,8 +15,9 @@
 // motion that a rigid motion of the frame explains (least squares over the field;
 // rotation only at infinity) is removed. calibrate fits that motion once, at the boards'
 // median distance, and applies it at every distance (align_at_mm): fitted per distance
-// its translation grows with the distance and hides a zoom-like error far away (0.027 px
-// predicted at 10 m and 99.9 km, then 0.085 at infinity, on the README's calibration). Board poses absorb any rigid motion of the
+// its translation grows with the distance and hides a zoom-like error far away (0.027
+// px predicted at 10 m and 99.9 km, then 0.085 at infinity, on the README's
+// calibration). Board poses absorb any rigid motion of the
 // frame, so the data fix it only through small effects (a pinhole's principal point with
 // the mirror's tilt and decenter nearly turns the camera; the dolly zoom, fx with m,
 // nearly slides the mirror's rays along the axis): kept, that uncertainty of where the
@@ -57,6 +58,7 @@ struct PredictedError {
   double median_px = 0.0, max_px = 0.0;  // over the predicted pixels
   int unpredicted = 0;                    // pixels whose point did not project
   double aligned_at_mm = NAN;             // where the alignment was fitted (NaN: none could be)
+  bool aligned_once = false;              // at align_at_mm for every distance (else at this one)
   // The same with the frame's own uncertainty kept: points held fixed in the camera's
   // frame, no alignment (what matters only where that frame is itself used, e.g. the
   // camera's mount measured as the reference).

@@ -101,8 +101,9 @@ class AlignmentCost : public ceres::CostFunction {
 
 // The reference's points distance_mm along the pixels' rays (columns of *points) and the
 // pixels (*kept_pixels) where both sensors project them; returns their indices.
-std::vector<size_t> PointsBothProject(const Sensor& reference, const Sensor& other, const std::vector<Eigen::Vector2d>& pixels,
-                                      double distance_mm, Eigen::Matrix3Xd* points, Eigen::Matrix2Xd* kept_pixels) {
+std::vector<size_t> PointsBothProject(const Sensor& reference, const Sensor& other,
+                                      const std::vector<Eigen::Vector2d>& pixels, double distance_mm,
+                                      Eigen::Matrix3Xd* points, Eigen::Matrix2Xd* kept_pixels) {
   Eigen::Matrix2Xd grid(2, pixels.size());
   for (size_t k = 0; k < pixels.size(); ++k) grid.col(k) = pixels[k];
   Eigen::Matrix3Xd origins, directions;
@@ -144,8 +145,10 @@ std::vector<Eigen::Vector2d> ComparisonField(const Sensor& reference, const Dete
 ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, const std::vector<Eigen::Vector2d>& pixels,
                                   double distance_mm, bool align, double align_at_mm) {
   if (const std::string why = ObjectDistanceProblem(distance_mm); !why.empty()) throw InputError("distance_mm: " + why);
+  if (!align && !std::isnan(align_at_mm)) throw InputError("align_at_mm: given without the alignment (align off)");
   const double fit_at_mm = std::isnan(align_at_mm) ? distance_mm : align_at_mm;
-  if (const std::string why = ObjectDistanceProblem(fit_at_mm); align && !why.empty()) throw InputError("align_at_mm: " + why);
+  if (const std::string why = ObjectDistanceProblem(fit_at_mm); align && !why.empty())
+    throw InputError("align_at_mm: " + why);
   ProjectionDiff diff;
   diff.distance_mm = distance_mm;
   diff.pixels = pixels;
@@ -164,7 +167,6 @@ ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, 
   const Sensor wide = WithoutCameraBody(SensorWithWiderRim(other, 1.15));
   Eigen::Matrix2Xd before;
   MovedPixels(wide, kept_points, angle_axis, translation, &before);
-  diff.unaligned_rms_px = std::sqrt((before - kept_pixels).colwise().squaredNorm().mean());
   if (align) {
     Eigen::Matrix3Xd fit_points = kept_points;
     Eigen::Matrix2Xd fit_pixels = kept_pixels;
@@ -199,16 +201,25 @@ ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, 
                                                : Eigen::Quaterniond::Identity();
   diff.translation_mm = Eigen::Vector3d(translation[0], translation[1], translation[2]);
   std::vector<double> lengths;
-  double square = 0.0;
+  double square = 0.0, unaligned_square = 0.0;
   for (size_t i = 0; i < kept.size(); ++i) {
-    if (after_status[i] != ProjectionStatus::kOk) continue;
+    if (after_status[i] != ProjectionStatus::kOk) {
+      ++diff.moved_off_mirror;
+      continue;
+    }
     const Eigen::Vector2d d = after.col(i) - kept_pixels.col(i);
     diff.difference_px[kept[i]] = d;
     lengths.push_back(d.norm());
     square += d.squaredNorm();
+    unaligned_square += (before.col(i) - kept_pixels.col(i)).squaredNorm();
   }
   diff.compared = static_cast<int>(lengths.size());
+  if (diff.compared < 6)
+    throw InputError("align_at_mm: the rigid motion fitted there moves all but " + std::to_string(diff.compared) +
+                     " field points off the other calibration's mirror (need >= 6 compared)");
+  // Before and after over the same pixels: those compared.
   diff.rms_px = diff.compared > 0 ? std::sqrt(square / diff.compared) : NAN;
+  diff.unaligned_rms_px = diff.compared > 0 ? std::sqrt(unaligned_square / diff.compared) : NAN;
   MedianAndMax(lengths, &diff.median_px, &diff.max_px);
   return diff;
 }

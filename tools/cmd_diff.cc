@@ -5,6 +5,7 @@
 
 #include "calib/calibration_json.h"
 #include "calib/detections.h"
+#include "calib/predicted_error.h"
 #include "calib/projection_diff.h"
 #include "calib/report/projection_diff_figure.h"
 #include "model/io/atomic_write.h"
@@ -54,14 +55,22 @@ void RunDiff(const DiffFlags& options, const Context& context) {
     // The figure first: a figure that cannot be written leaves no diff.json to mistake for a run.
     WriteProjectionDiffFigure((dir / "diff.png").string(), diff, a.image_width_px(), a.image_height_px(),
                               "b: " + SensorFileOf(options.b) + " against a: " + SensorFileOf(options.a));
-    WriteProjectionDiffJson(diff, {{"a", SensorFileOf(options.a)}, {"b", SensorFileOf(options.b)}, {"field", field_label}},
+    WriteProjectionDiffJson(diff,
+                            {{"a", SensorFileOf(options.a)}, {"b", SensorFileOf(options.b)}, {"field", field_label}},
                             (dir / "diff.json").string());
   }
   if (context.quiet) return;
   std::printf("at %.0f mm over %d pixels (%s): RMS %.4f px, median %.4f px, max %.4f px\n", options.distance_mm,
               diff.compared, field_label.c_str(), diff.rms_px, diff.median_px, diff.max_px);
+  if (diff.moved_off_mirror > 0)
+    std::printf("not compared: %d field pixels, whose points the alignment fitted at %.0f mm moved off b's mirror\n",
+                diff.moved_off_mirror, diff.aligned_at_mm);
   char fitted[64];
-  std::snprintf(fitted, sizeof fitted, "fitted at %.0f mm", diff.aligned_at_mm);
+  if (diff.aligned_at_mm >= kInfinityMm) {
+    std::snprintf(fitted, sizeof fitted, "fitted at infinity");
+  } else {
+    std::snprintf(fitted, sizeof fitted, "fitted at %.0f mm", diff.aligned_at_mm);
+  }
   std::printf("alignment: %s, rotation %.4f deg, translation (%.3f, %.3f, %.3f) mm; before it: RMS %.4f px\n",
               diff.aligned        ? fitted
               : options.no_align ? "none (--no-align)"
@@ -90,7 +99,8 @@ Command DiffCommand() {
                            "Fit the rigid alignment at this distance (e.g. the boards') and apply it at --distance-mm "
                            "(default: fitted at --distance-mm)")
                 ->check(kPositive);
-            sub.add_flag("--no-align", options->no_align, "Compare without the rigid alignment")->excludes("--align-at-mm");
+            sub.add_flag("--no-align", options->no_align, "Compare without the rigid alignment")
+                ->excludes("--align-at-mm");
             sub.add_option("--out", options->out_dir, "Output directory for diff.json and diff.png");
             return [options, &context]() { RunDiff(*options, context); };
           }};

@@ -36,7 +36,7 @@ void WritePredictedErrorMap(const std::string& path, const Sensor& sensor, const
   std::snprintf(text, sizeof text, "predicted error at %s: median %.3f px, worst %.3f px", label.c_str(), map.median_px,
                 map.max_px);
   cv::putText(picture, text, {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
-  if (std::isfinite(map.aligned_at_mm)) {
+  if (map.aligned_once) {
     std::snprintf(text, sizeof text, "after the rigid alignment fitted at %.0f mm, as omnical diff --align-at-mm",
                   map.aligned_at_mm);
   } else {

@@ -342,7 +342,8 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
     assert [list(h) for h in cross["halves"]] == cli["cross_validation"]["halves"]
     assert close(cross["rms_px"], cli["cross_validation"]["diff_rms_px"]) and cross["distance_mm"] == 1500
     boards, cli_boards = cross["aligned_at_boards"], cli["cross_validation"]["aligned_at_boards"]
-    assert close(boards["rms_px"], cli_boards["diff_rms_px"]) and close(boards["aligned_at_mm"], cli_boards["aligned_at_mm"])
+    assert close(boards["rms_px"], cli_boards["diff_rms_px"])
+    assert close(boards["aligned_at_mm"], cli_boards["aligned_at_mm"])
     assert omnical.load_calibration(tmp_path / "cli" / "calibration.json").holdout["views"] == held["views"]
     warp = result.board_warp
     assert close(warp["x_mm"], cli["board_warp"]["x_mm"]) and close(warp["std_y_mm"], cli["board_warp"]["std_y_mm"])
@@ -410,6 +411,8 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
     with pytest.raises(omnical.InputError) as raised:
         omnical.diff(result.sensor, result.sensor, align_at_mm=1e9)
     assert str(raised.value) == too_far.replace("--align-at-mm", "align_at_mm")
+    with pytest.raises(omnical.InputError, match="align_at_mm: given without the alignment"):
+        omnical.diff(result.sensor, result.sensor, align=False, align_at_mm=300)
 
 
 def test_holdout_folds_equal_cli(runs, tmp_path):

@@ -161,7 +161,8 @@ py::dict PoseMatrices(const std::map<std::string, TargetPose>& poses) {
 py::dict DiffDict(const ProjectionDiff& d) {
   return py::dict("distance_mm"_a = d.distance_mm >= kInfinityMm ? HUGE_VAL : d.distance_mm, "rms_px"_a = d.rms_px,
                   "median_px"_a = d.median_px, "max_px"_a = d.max_px, "unaligned_rms_px"_a = d.unaligned_rms_px,
-                  "compared"_a = d.compared, "aligned"_a = d.aligned, "aligned_at_mm"_a = d.aligned_at_mm,
+                  "compared"_a = d.compared, "moved_off_mirror"_a = d.moved_off_mirror, "aligned"_a = d.aligned,
+                  "aligned_at_mm"_a = d.aligned_at_mm >= kInfinityMm ? HUGE_VAL : d.aligned_at_mm,
                   "rotation_deg"_a = d.rotation_deg,
                   "translation_mm"_a = py::make_tuple(d.translation_mm.x(), d.translation_mm.y(), d.translation_mm.z()));
 }
@@ -314,7 +315,8 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
         py::dict out = DiffDict(c->diff);
         out["halves"] = py::make_tuple(c->halves[0], c->halves[1]);
         out["half_rms_px"] = py::make_tuple(c->half_rms_px[0], c->half_rms_px[1]);
-        out["aligned_at_boards"] = c->diff_aligned_at_boards ? py::object(DiffDict(*c->diff_aligned_at_boards)) : py::none();
+        out["aligned_at_boards"] =
+            c->diff_aligned_at_boards ? py::object(DiffDict(*c->diff_aligned_at_boards)) : py::none();
         return out;
       },
       "The two halves' comparison (cross_validate=True): dict halves, half_rms_px, distance_mm, rms_px, median_px, "
@@ -340,7 +342,8 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
       "The predicted projection error per distance: list of dicts (distance_mm (inf for infinity), n_rim_radii, "
       "median_px, max_px (after the rigid alignment fitted at aligned_at_mm, the boards' median distance, as "
       "diff(align_at_mm=...)), field_pixels, unpredicted_pixels, in_camera_frame_median_px, in_camera_frame_max_px "
-      "(points held in the camera's frame), aligned_at_mm (nan: fitted at each distance, an older file)).");
+      "(points held in the camera's frame), aligned_at_mm (nan: fitted at each distance: an older file, or too few "
+      "field pixels project at the boards' distance)).");
   cls.def(
       "to_json", [record](const Holder& holder) { return CalibrationJsonText(record(holder)); },
       "The text of calibration.json.");
@@ -818,10 +821,10 @@ projected through b. That motion is fitted at distance_mm, or at align_at_mm and
 at distance_mm (one motion for a scene that spans distances: align_at_mm the boards'
 distance, as calibrate's predicted_error). field: Detections or a detections file whose
 corners' annulus is compared, None for every pixel of a's mirror; step_px apart. Returns
-rms_px, median_px, max_px, unaligned_rms_px, compared, aligned, aligned_at_mm,
-rotation_deg, translation_mm, distance_mm, pixels (N, 2) and difference_px (N, 2; NaN
-where either does not project or, aligned elsewhere, the moved point falls off b's
-mirror).)");
+rms_px, median_px, max_px, unaligned_rms_px (both over the compared pixels), compared,
+moved_off_mirror (aligned elsewhere, points the motion moved past b's rim: not compared),
+aligned, aligned_at_mm (inf for infinity), rotation_deg, translation_mm, distance_mm,
+pixels (N, 2) and difference_px (N, 2; NaN where not compared).)");
 }
 
 }  // namespace

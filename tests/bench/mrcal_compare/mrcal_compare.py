@@ -214,7 +214,8 @@ def omnical_side(dataset, cli, out, log):
         if cross.get("aligned_at_boards"):  # omnical after 2026-11-29: one alignment fitted at the boards
             boards = cross["aligned_at_boards"]
             row["halves"].update(boards_diff_rms_px=float(boards["diff_rms_px"]),
-                                 boards_diff_max_px=float(boards["diff_max_px"]), boards_mm=float(boards["aligned_at_mm"]))
+                                 boards_diff_max_px=float(boards["diff_max_px"]),
+                                 boards_mm=float(boards["aligned_at_mm"]))
     elif cli.has_diff:
         log(f"{dataset.name}: omnical calibrate per half, omnical diff")
         fits = []
