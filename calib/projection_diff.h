@@ -18,7 +18,7 @@
 // distance. Far from where the boards were, its translation grows with the distance
 // (16 mm at 2 m, 80 mm at 10 m between the real dev set's halves, boards at 0.2-0.45 m)
 // and takes up a zoom-like disagreement no pose could absorb, so it reads low there: 0.29
-// px at 2 m, 1.55 px at infinity, where only a rotation is fitted. With align_at_mm the
+// px at 2 m, 1.54 px at infinity, where only a rotation is fitted. With align_at_mm the
 // one rigid motion fitted at that distance (the boards') is applied at every distance:
 // 1.28 px at 2 m, continuous into infinity: what a scene spanning distances sees.
 #pragma once
