@@ -16,20 +16,6 @@ double ParameterValue(const Sensor& sensor, const std::string& name, double fall
   return fallback;
 }
 
-// The camera-frame points at distance_mm along the pixels' rays (NaN where unprojectable).
-Eigen::Matrix3Xd PointsAt(const Sensor& sensor, const std::vector<Eigen::Vector2d>& pixels, double distance_mm) {
-  Eigen::Matrix2Xd grid(2, pixels.size());
-  for (size_t k = 0; k < pixels.size(); ++k) grid.col(k) = pixels[k];
-  Eigen::Matrix3Xd origins, directions;
-  std::vector<ProjectionStatus> statuses;
-  sensor.UnprojectBatch(grid, &origins, &directions, &statuses);
-  Eigen::Matrix3Xd points(3, pixels.size());
-  for (size_t k = 0; k < pixels.size(); ++k)
-    points.col(k) = statuses[k] == ProjectionStatus::kOk ? Eigen::Vector3d(origins.col(k) + distance_mm * directions.col(k))
-                                                          : Eigen::Vector3d::Constant(NAN);
-  return points;
-}
-
 Eigen::Matrix2Xd Projected(const Sensor& sensor, const Eigen::Matrix3Xd& points) {
   Eigen::Matrix2Xd pixels;
   std::vector<ProjectionStatus> statuses;
@@ -96,6 +82,20 @@ bool FitRigidMotion(const Eigen::MatrixXd& rigid, const Eigen::MatrixXd& derivat
 }
 
 }  // namespace
+
+Eigen::Matrix3Xd PointsAlongRays(const Sensor& sensor, const std::vector<Eigen::Vector2d>& pixels, double distance_mm) {
+  Eigen::Matrix2Xd grid(2, pixels.size());
+  for (size_t k = 0; k < pixels.size(); ++k) grid.col(k) = pixels[k];
+  Eigen::Matrix3Xd origins, directions;
+  std::vector<ProjectionStatus> statuses;
+  sensor.UnprojectBatch(grid, &origins, &directions, &statuses);
+  Eigen::Matrix3Xd points(3, pixels.size());
+  for (size_t k = 0; k < pixels.size(); ++k)
+    points.col(k) = statuses[k] == ProjectionStatus::kOk
+                        ? Eigen::Vector3d(origins.col(k) + distance_mm * directions.col(k))
+                        : Eigen::Vector3d::Constant(NAN);
+  return points;
+}
 
 void MedianAndMax(std::vector<double> values, double* median, double* max) {
   values.erase(std::remove_if(values.begin(), values.end(), [](double v) { return !std::isfinite(v); }), values.end());
@@ -199,29 +199,38 @@ std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const F
     }
     return derivative;
   };
+  // Each parameter's pixel motion and the rigid generators' at one distance.
+  struct Fields {
+    Eigen::MatrixXd derivative, rigid;
+  };
+  const auto fields_at = [&](double distance_mm, bool with_translation) {
+    const Eigen::Matrix3Xd points = PointsAlongRays(sensor, pixels, distance_mm);
+    return Fields{parameter_fields(points), RigidMotionFields(wide, points, with_translation)};
+  };
   // One rigid motion per parameter direction, fitted at align_at_mm and applied at every
   // distance (calib/projection_diff.h): its coefficients on the rigid generators. Where
   // too few field pixels project there, each distance is aligned on its own.
   bool align_once = !std::isnan(align_at_mm);
   Eigen::MatrixXd motion_per_parameter;
+  Fields at_alignment;
   if (align_once) {
-    const Eigen::Matrix3Xd points = PointsAt(sensor, pixels, align_at_mm);
-    align_once = FitRigidMotion(RigidMotionFields(wide, points, align_at_mm < kInfinityMm), parameter_fields(points),
-                                &motion_per_parameter);
+    at_alignment = fields_at(align_at_mm, align_at_mm < kInfinityMm);
+    align_once = FitRigidMotion(at_alignment.rigid, at_alignment.derivative, &motion_per_parameter);
   }
   std::vector<PredictedError> maps;
   for (double distance_mm : distances_mm) {
-    const Eigen::Matrix3Xd points = PointsAt(sensor, pixels, distance_mm);
-    Eigen::MatrixXd derivative = parameter_fields(points);
+    // At infinity a translation moves nothing: rotation only, unless fitted elsewhere.
+    const bool with_translation = align_once ? align_at_mm < kInfinityMm : distance_mm < kInfinityMm;
+    // calibrate's first default distance is the alignment's own: its fields are taken.
+    Fields here = align_once && distance_mm == align_at_mm ? at_alignment : fields_at(distance_mm, with_translation);
+    Eigen::MatrixXd& derivative = here.derivative;
+    const Eigen::MatrixXd& rigid = here.rigid;
     PredictedError map;
     map.in_camera_frame_std_px.resize(pixels.size());
     for (size_t p = 0; p < pixels.size(); ++p)
       map.in_camera_frame_std_px[p] = StdOf(derivative.middleRows(2 * p, 2), fit.covariance);
-    // Less what a rigid motion of the frame explains (at infinity a translation moves
-    // nothing: rotation only), as diff aligns: fitted here by least squares over the
-    // pixels that predict, or the one fitted at align_at_mm.
-    const bool with_translation = align_once ? align_at_mm < kInfinityMm : distance_mm < kInfinityMm;
-    const Eigen::MatrixXd rigid = RigidMotionFields(wide, points, with_translation);
+    // Less what a rigid motion of the frame explains, as diff aligns: fitted here by least
+    // squares over the pixels that predict, or the one fitted at align_at_mm.
     Eigen::MatrixXd motion = motion_per_parameter;
     // A pixel the alignment could not weigh (its rigid motion does not project, or too few
     // do) has no aligned figure.
@@ -249,7 +258,7 @@ std::vector<PredictedError> PredictProjectionError(const Sensor& sensor, const F
 
 std::vector<double> ProjectionDisplacement(const Sensor& reference, const Sensor& other,
                                            const std::vector<Eigen::Vector2d>& pixels, double distance_mm) {
-  const Eigen::Matrix3Xd points = PointsAt(reference, pixels, distance_mm);
+  const Eigen::Matrix3Xd points = PointsAlongRays(reference, pixels, distance_mm);
   const Eigen::Matrix2Xd moved = Projected(other, points);
   const Eigen::Matrix2Xd back = Projected(reference, points);
   std::vector<double> displacement(pixels.size());

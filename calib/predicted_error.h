@@ -48,6 +48,10 @@ struct ObservedField {
 };
 ObservedField FieldOfCorners(const Sensor& sensor, const DetectionSet& detections);
 
+// The camera-frame points distance_mm along the pixels' rays through the sensor, from
+// their reflection points; NaN columns where a pixel does not unproject.
+Eigen::Matrix3Xd PointsAlongRays(const Sensor& sensor, const std::vector<Eigen::Vector2d>& pixels, double distance_mm);
+
 // Pixels on a square grid (step_px apart) inside the field and seen through the sensor.
 std::vector<Eigen::Vector2d> FieldPixels(const Sensor& sensor, const ObservedField& field, double step_px);
 

@@ -104,19 +104,13 @@ class AlignmentCost : public ceres::CostFunction {
 std::vector<size_t> PointsBothProject(const Sensor& reference, const Sensor& other,
                                       const std::vector<Eigen::Vector2d>& pixels, double distance_mm,
                                       Eigen::Matrix3Xd* points, Eigen::Matrix2Xd* kept_pixels) {
-  Eigen::Matrix2Xd grid(2, pixels.size());
-  for (size_t k = 0; k < pixels.size(); ++k) grid.col(k) = pixels[k];
-  Eigen::Matrix3Xd origins, directions;
-  std::vector<ProjectionStatus> unprojected;
-  reference.UnprojectBatch(grid, &origins, &directions, &unprojected);
-  const Eigen::Matrix3Xd all = origins + distance_mm * directions;
+  const Eigen::Matrix3Xd all = PointsAlongRays(reference, pixels, distance_mm);  // NaN where unprojectable
   Eigen::Matrix2Xd through_other;
   std::vector<ProjectionStatus> projected;
   other.ProjectBatch(all, &through_other, &projected);
   std::vector<size_t> kept;
   for (size_t k = 0; k < pixels.size(); ++k)
-    if (unprojected[k] == ProjectionStatus::kOk && projected[k] == ProjectionStatus::kOk && all.col(k).allFinite())
-      kept.push_back(k);
+    if (projected[k] == ProjectionStatus::kOk && all.col(k).allFinite()) kept.push_back(k);
   points->resize(3, kept.size());
   kept_pixels->resize(2, kept.size());
   for (size_t i = 0; i < kept.size(); ++i) points->col(i) = all.col(kept[i]), kept_pixels->col(i) = pixels[kept[i]];
@@ -218,8 +212,8 @@ ProjectionDiff CompareProjections(const Sensor& reference, const Sensor& other, 
     throw InputError("align_at_mm: the rigid motion fitted there moves all but " + std::to_string(diff.compared) +
                      " field points off the other calibration's mirror (need >= 6 compared)");
   // Before and after over the same pixels: those compared.
-  diff.rms_px = diff.compared > 0 ? std::sqrt(square / diff.compared) : NAN;
-  diff.unaligned_rms_px = diff.compared > 0 ? std::sqrt(unaligned_square / diff.compared) : NAN;
+  diff.rms_px = std::sqrt(square / diff.compared);
+  diff.unaligned_rms_px = std::sqrt(unaligned_square / diff.compared);
   MedianAndMax(lengths, &diff.median_px, &diff.max_px);
   return diff;
 }

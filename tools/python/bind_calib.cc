@@ -157,12 +157,15 @@ py::dict PoseMatrices(const std::map<std::string, TargetPose>& poses) {
   return out;
 }
 
+// A distance for Python: inf where the library's stands for infinity (kInfinityMm).
+double PythonDistanceMm(double distance_mm) { return distance_mm >= kInfinityMm ? HUGE_VAL : distance_mm; }
+
 // A projection difference's summary (as calibration.json's cross_validation and diff.json).
 py::dict DiffDict(const ProjectionDiff& d) {
-  return py::dict("distance_mm"_a = d.distance_mm >= kInfinityMm ? HUGE_VAL : d.distance_mm, "rms_px"_a = d.rms_px,
+  return py::dict("distance_mm"_a = PythonDistanceMm(d.distance_mm), "rms_px"_a = d.rms_px,
                   "median_px"_a = d.median_px, "max_px"_a = d.max_px, "unaligned_rms_px"_a = d.unaligned_rms_px,
                   "compared"_a = d.compared, "moved_off_mirror"_a = d.moved_off_mirror, "aligned"_a = d.aligned,
-                  "aligned_at_mm"_a = d.aligned_at_mm >= kInfinityMm ? HUGE_VAL : d.aligned_at_mm,
+                  "aligned_at_mm"_a = PythonDistanceMm(d.aligned_at_mm),
                   "rotation_deg"_a = d.rotation_deg,
                   "translation_mm"_a = py::make_tuple(d.translation_mm.x(), d.translation_mm.y(), d.translation_mm.z()));
 }
@@ -335,7 +338,7 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
                               "unpredicted_pixels"_a = p.unpredicted_pixels,
                               "in_camera_frame_median_px"_a = p.in_camera_frame_median_px,
                               "in_camera_frame_max_px"_a = p.in_camera_frame_max_px,
-                              "aligned_at_mm"_a = p.aligned_at_mm));
+                              "aligned_at_mm"_a = PythonDistanceMm(p.aligned_at_mm)));
         }
         return out;
       },
@@ -718,7 +721,7 @@ are also attributes here), the warnings with their codes, the views and residual
               const PredictedError& map = c.result.predicted[k];
               std::vector<double> std_px = map.std_px;
               out.append(py::dict("label"_a = k < c.result.distance_labels.size() ? c.result.distance_labels[k] : "",
-                                  "distance_mm"_a = map.distance_mm >= kInfinityMm ? HUGE_VAL : map.distance_mm,
+                                  "distance_mm"_a = PythonDistanceMm(map.distance_mm),
                                   "pixels"_a = PointsArray(map.pixels), "std_px"_a = VectorArray(std::move(std_px))));
             }
             return out;
