@@ -27,6 +27,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 #include <map>
 #include <optional>
 #include <set>
@@ -100,6 +101,10 @@ struct FitResult {
   // How the tolerances were applied where that is not as given (ignored on a held
   // parameter, folded into another), one line each.
   std::vector<std::string> tolerance_notes;
+  // A spline's c1 where the covariance holds it at its fitted value (a near-gauge of the
+  // knots: calib/bundle_fit.cc): its std as a share of its value before; NaN otherwise.
+  // `parameters` then report it held, and the covariance leaves it out.
+  double vertex_curvature_std_ratio = NAN;
   double guess_rim_radius_mm = 0.0;  // the guess's rim, for comparison with the fitted sensor's
   // Corner residuals' standard deviation per coordinate (px), from the fit's RMS and its
   // degrees of freedom: what the covariance is scaled by. With per-view weights, that of

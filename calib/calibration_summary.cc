@@ -28,9 +28,13 @@ void AppendFormatted(std::string& out, const char* format, ...) {
 void AppendNamedChoice(const char* what, const NamedChoice& choice, std::string* out) {
   *out += std::string(what) + " chosen by " + std::to_string(choice.folds) + " held-out folds (" +
           std::to_string(choice.held_out_corners) + " corners):";
-  for (size_t k = 0; k < choice.candidates.size(); ++k)
-    AppendFormatted(*out, " %s: %.4f px%s", choice.candidates[k].c_str(), choice.held_out_rms_px[k],
-                    choice.candidates[k] == choice.chosen ? " (chosen)" : "");
+  for (size_t k = 0; k < choice.candidates.size(); ++k) {
+    const char* chosen = choice.candidates[k] == choice.chosen ? " (chosen)" : "";
+    if (std::isfinite(choice.held_out_rms_px[k]))
+      AppendFormatted(*out, " %s: %.4f px%s", choice.candidates[k].c_str(), choice.held_out_rms_px[k], chosen);
+    else  // calibration.json's null: a fold without a fit, a valid sensor or a held-out residual
+      AppendFormatted(*out, " %s: not scored%s", choice.candidates[k].c_str(), chosen);
+  }
   *out += choice.AnyScored() ? "\n" : " (none scored: the first kept)\n";
 }
 

@@ -92,7 +92,7 @@ std::vector<CovarianceFinding> WeakParameters(const std::vector<CovarianceParame
     // Scale-like: relative to the value. A tilt: beyond 2 deg it is not determined at all
     // (a nearly spherical mirror turned about its centre; the bundled sets reach 1.1 deg
     // at worst).
-    const bool weak = p.scale_like ? p.value != 0.0 && std > 0.05 * std::abs(p.value)
+    const bool weak = p.scale_like ? p.value != 0.0 && std > kWeakRelativeStd * std::abs(p.value)
                                     : p.group == ParameterGroup::kTilt && std > kWeakTiltStdDeg;
     if (!weak) continue;
     char spread[80];

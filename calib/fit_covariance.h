@@ -46,8 +46,10 @@ struct CovarianceParameter {
 };
 
 constexpr double kWeakTiltStdDeg = 2.0;
+// A scale-like parameter is weakly determined past this std relative to its value.
+constexpr double kWeakRelativeStd = 0.05;
 
-// The free scale-like parameters whose std exceeds 5 % of their value, and tilts known to
+// The free scale-like parameters whose std exceeds kWeakRelativeStd of their value, and tilts known to
 // no better than kWeakTiltStdDeg (the others are
 // naturally near zero, where a relative std means nothing), each named with the parameter
 // of another group it is most correlated with when that correlation is >= 0.9: the valley

@@ -441,6 +441,17 @@ TEST(CalibrateApi, WithoutAGuessTheLensIsChosenWhereTheViewsAllowFolds) {
   EXPECT_EQ(profile.held_out_rms_px[0], lens.held_out_rms_px[chosen_lens]);
   EXPECT_NE(chosen.record.start.find(profile.chosen + " mirror (chosen by held-out folds)"), std::string::npos)
       << chosen.record.start;
+  // The spline is the last candidate, through the orthographic lens only (calib/calibrate.cc:
+  // through the pinhole its offset slides with the focal length): a knot count or "no spline",
+  // which is the family chosen.
+  EXPECT_EQ(chosen.record.knot_choice.has_value(), lens.chosen == "orthographic");
+  if (const auto& knots = chosen.record.knot_choice) {
+    EXPECT_EQ(knots->base_profile, profile.chosen);
+    EXPECT_EQ(knots->candidates.front(), 0);  // no spline first
+    const std::string said = knots->chosen > 0 ? std::to_string(knots->chosen) + " knots" : "no spline";
+    EXPECT_NE(chosen.record.start.find(said), std::string::npos) << chosen.record.start;
+    EXPECT_STREQ(chosen.sensor.profile_name(), knots->chosen > 0 ? "spline" : profile.chosen.c_str());
+  }
   for (const CalibrationWarning& w : chosen.warnings) {
     EXPECT_NE(w.code, WarningCode::kTangentialNotFitted) << w.text;
     EXPECT_NE(w.code, WarningCode::kLensNotChosen) << w.text;
@@ -452,6 +463,7 @@ TEST(CalibrateApi, WithoutAGuessTheLensIsChosenWhereTheViewsAllowFolds) {
   EXPECT_FALSE(few.record.lens_choice.has_value());
   EXPECT_FALSE(few.record.tangential_choice.has_value());
   EXPECT_FALSE(few.record.profile_choice.has_value());
+  EXPECT_FALSE(few.record.knot_choice.has_value());
   EXPECT_STREQ(few.sensor.profile_name(), "polynomial");
   EXPECT_STREQ(few.sensor.lens_name(), "orthographic");
   EXPECT_EQ(few.record.start, "rim circle, polynomial mirror, orthographic lens");

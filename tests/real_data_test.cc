@@ -138,8 +138,14 @@ TEST(RealImages, MeiParabolicDetectsAndCalibrates) {
   const NamedChoice& lens = *chosen.lens_choice;
   std::printf("lens choice: orthographic %.4f px, pinhole %.4f px held out\n", lens.held_out_rms_px[0], lens.held_out_rms_px[1]);
   EXPECT_EQ(lens.chosen, "orthographic");
+  // ... then, through the orthographic lens, the spline's knot count or none: none here (a
+  // manufactured paraboloid, which the polynomial describes; docs/calibrate.md).
   EXPECT_EQ(std::string(chosen.start),
-            "rim circle, polynomial mirror (chosen by held-out folds), orthographic lens (chosen by held-out folds)");
+            "rim circle, polynomial mirror (chosen by held-out folds), orthographic lens (chosen by held-out folds), "
+            "no spline (chosen by held-out folds)");
+  ASSERT_TRUE(chosen.knot_choice.has_value());
+  EXPECT_EQ(chosen.knot_choice->chosen, 0);
+  EXPECT_EQ(chosen.knot_choice->base_profile, "polynomial");
   // The pinhole is fitted and scored, not refused: the choice is by prediction.
   EXPECT_TRUE(std::isfinite(lens.held_out_rms_px[1]));
   EXPECT_GT(lens.held_out_rms_px[1], lens.held_out_rms_px[0]);

@@ -94,8 +94,8 @@ Command CalibrateCommand() {
             sub.add_option("--profile", library.profile,
                            "Mirror family to fit: " + JoinChoices(ProfileNames(false)) +
                                " (a hyperboloid needs --sensor; a guess of another family is converted), or auto (the "
-                               "default without a guess, with >= 4 usable views): the polynomial or the even asphere by "
-                               "held-out folds, as --lens auto")
+                               "default without a guess, with >= 4 usable views): the polynomial or the even asphere, "
+                               "then through the orthographic lens a spline's knot count or none, by held-out folds")
                 ->check(CLI::IsMember(CalibrationProfileNames()));
             sub.add_option("--rim-field-deg", library.rim_field_deg,
                            "Without a guess: the rim ray's angle from the mirror axis (Omega, deg) to start from")

@@ -262,7 +262,8 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
         return py::dict("base_profile"_a = k->base_profile, "candidates"_a = k->candidates, "held_out_rms_px"_a = k->held_out_rms_px,
                         "held_out_corners"_a = k->held_out_corners, "folds"_a = k->folds, "chosen"_a = k->chosen);
       },
-      "The spline's knot count chosen by held-out folds (knots='auto'): dict base_profile, candidates (0: base_profile, no spline), held_out_rms_px (per "
+      "The spline's knot count chosen by held-out folds (knots='auto', or by default without a guess through the "
+      "orthographic lens): dict base_profile, candidates (0: base_profile, no spline), held_out_rms_px (per "
       "candidate), held_out_corners, folds, chosen; None unless chosen.");
   const auto named_choice = [](const std::optional<NamedChoice>& choice) -> py::object {
     if (!choice) return py::none();
@@ -754,7 +755,8 @@ views), 'orthographic' or 'pinhole'). tangential: a pinhole's p1, p2, 'off' (hel
 a guess), 'on' (fitted) or 'auto' ('' without a guess: fitted where that predicts held-out
 folds better, result.tangential_choice). profile: mirror family to fit
 (one of omnical.PROFILES but tabulated; '' the guess's; without a guess 'auto', '' too:
-the polynomial or the even asphere by held-out folds, result.profile_choice; the
+the polynomial or the even asphere by held-out folds, result.profile_choice, then through
+the orthographic lens a spline's knot count or none, result.knot_choice; the
 polynomial with under 4 views). fixed: blocks held (lens,
 lens_scale, principal_point, distortion, tangential, m, tilt, decenter, shape, poses; a list or 'a,b').
 loss_px: Huber scale (0: least squares). detection_passes: 2 re-detects through the

@@ -15,6 +15,8 @@ Usage:
   /usr/bin/python3 tests/bench/mrcal_compare/mrcal_compare.py --omnical build/test/tools/omnical \\
       --out docs/calibration-vs-mrcal.md [--quick] [--checkerboard-subpixel] [--work DIR]
 --quick: the real set and the 10-knot model only (the CTest test, < 60 s).
+--extra NAME=TARGET.yaml:IMAGE_DIR (repeatable): one more real set, calibrated without a
+guess as a new user would (your own images; with --datasets NAME to run only those).
 --checkerboard-subpixel: the checkerboard sets' corners from `calibrate --images
 --checkerboard-subpixel` (cornerSubPix, the default before edges; both tools then fit
 those). Exit 77
@@ -115,6 +117,20 @@ def datasets(real_dir):
                 os.path.join(synthetic, "rendered/ohte-sph-misaligned-near"),
                 os.path.join(synthetic, "sensors/ohte-sph-misaligned-guess.yaml")),
     ]
+
+
+def extra_dataset(spec):
+    """--extra NAME=TARGET.yaml:IMAGE_DIR: a set of the user's own, without a guess."""
+    name, _, paths = spec.partition("=")
+    target, _, images = paths.partition(":")
+    if not name or not target or not images:
+        raise BenchError(f"--extra '{spec}': expected NAME=TARGET.yaml:IMAGE_DIR")
+    for path in (target, images):
+        if not os.path.exists(path):
+            raise BenchError(f"--extra {name}: {path}: not found")
+    count = len([f for f in os.listdir(images) if os.path.isfile(os.path.join(images, f))])
+    return Dataset(name, f"{count} images in {os.path.basename(os.path.abspath(images))}, {os.path.basename(target)}",
+                   os.path.abspath(target), os.path.abspath(images))
 
 
 def evenly_spaced(count, k):
@@ -536,6 +552,8 @@ def main():
     parser.add_argument("--real-data", default=os.path.join(ROOT, "..", "shared", "real-data", "mei-parabolic"),
                         help="the mei-parabolic images (default: ../shared/real-data/mei-parabolic)")
     parser.add_argument("--datasets", help="comma-separated subset of the dataset names")
+    parser.add_argument("--extra", action="append", default=[], metavar="NAME=TARGET.yaml:IMAGE_DIR",
+                        help="one more image set (repeatable), calibrated without a guess")
     parser.add_argument("--checkerboard-subpixel", action="store_true",
                         help="checkerboard corners from `calibrate --images --checkerboard-subpixel` (both tools fit them)")
     args = parser.parse_args()
@@ -549,6 +567,7 @@ def main():
     chosen = datasets(os.path.abspath(args.real_data))
     if args.quick:
         chosen = chosen[:1]
+    chosen += [extra_dataset(spec) for spec in args.extra]
     if args.datasets:
         wanted = args.datasets.split(",")
         unknown = set(wanted) - {d.name for d in chosen}
