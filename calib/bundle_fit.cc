@@ -309,15 +309,33 @@ class FitRun {
   // boards' distance, where the corners fit to 0.19 px and held-out folds to 0.21; with c1
   // held the knots' stds are 0.035 mm and the prediction 0.14 px worst. Holding it moves
   // nothing: the fit is at its minimum, c1 at its fitted value.
+  // Only where the knots are what c1 trades with: given the knots, c1 is known to within
+  // kWeakRelativeStd (the conditional std, a Schur complement of the covariance). A c1 that
+  // trades with the lens scale or the decenter instead keeps its std and its warning.
   bool VertexCurvatureIsANearGauge(const std::map<const double*, std::vector<int>>& columns,
                                    const Eigen::MatrixXd& covariance) const {
     using Profile = typename Model::ProfileType;
     if constexpr (std::is_same_v<Profile, SplineProfile<double>>) {
+      if (!options_.hold_weak_vertex_curvature) return false;
       const auto found = columns.find(blocks_.shape.data());
       if (found == columns.end() || found->second.empty() || found->second[0] < 0) return false;
-      const int column = found->second[0];
-      const double c1 = blocks_.shape[0], std = std::sqrt(std::max(0.0, covariance(column, column)));
-      return c1 != 0.0 && std > kWeakRelativeStd * std::abs(c1);
+      const int c1_column = found->second[0];
+      std::vector<int> knot_columns;
+      for (size_t k = 1; k < found->second.size(); ++k)
+        if (found->second[k] >= 0) knot_columns.push_back(found->second[k]);
+      const double c1 = std::abs(blocks_.shape[0]), variance = covariance(c1_column, c1_column);
+      if (knot_columns.empty() || !(c1 > 0.0) || !(variance > std::pow(kWeakRelativeStd * c1, 2))) return false;
+      const int n = static_cast<int>(knot_columns.size());
+      Eigen::MatrixXd knots(n, n);
+      Eigen::VectorXd with_c1(n);
+      for (int i = 0; i < n; ++i) {
+        with_c1(i) = covariance(knot_columns[i], c1_column);
+        for (int j = 0; j < n; ++j) knots(i, j) = covariance(knot_columns[i], knot_columns[j]);
+      }
+      // The knots' own covariance may hold a further near-gauge (a constant offset): a
+      // pseudo-inverse, not a Cholesky.
+      const double given_knots = variance - with_c1.dot(knots.completeOrthogonalDecomposition().solve(with_c1));
+      return given_knots < std::pow(kWeakRelativeStd * c1, 2);
     }
     return false;
   }
@@ -589,7 +607,7 @@ class FitRun {
       vertex_curvature_held_ = true;
       problem_.SetManifold(blocks_.shape.data(),
                            new ceres::SubsetManifold(static_cast<int>(blocks_.shape.size()), HeldShapeEntries()));
-      columns = Columns();
+      columns = Columns(false);
       result_.covariance_ok = Covariance(columns, &covariance);
     }
     ReportParameters(columns, covariance);
@@ -637,7 +655,7 @@ class FitRun {
 
   // The covariance column of each entry of each free block (-1 where an entry is held by
   // the block's SubsetManifold), in the order Ceres evaluates the free blocks.
-  std::map<const double*, std::vector<int>> Columns() {
+  std::map<const double*, std::vector<int>> Columns(bool note_unused_tolerances = true) {
     std::map<const double*, std::vector<int>> columns;
     const std::vector<int> held_lens = HeldLensEntries(false);
     int column = 0;
@@ -658,7 +676,7 @@ class FitRun {
     }
     for (const Prior& prior : priors_) {
       const auto found = columns.find(prior.block);
-      if (found == columns.end() || found->second[prior.index] < 0)
+      if (note_unused_tolerances && (found == columns.end() || found->second[prior.index] < 0))
         result_.tolerance_notes.push_back("the tolerance on " + prior.name + " is not used: the parameter is held");
     }
     return columns;
@@ -692,13 +710,15 @@ class FitRun {
       estimate.value = block[index] * scale;
       const auto found = columns.find(block);
       const int column = found == columns.end() ? -1 : found->second[index];
-      estimate.fixed = column < 0;
+      // A spline's c1 held for the covariance was fitted: free, its std undetermined.
+      const bool held_for_covariance = vertex_curvature_held_ && block == blocks_.shape.data() && index == 0;
+      estimate.fixed = column < 0 && !held_for_covariance;
       if (result_.covariance_ok && column >= 0) {
         estimate.std = std::sqrt(std::max(0.0, covariance(column, column))) * scale;
         rows.push_back({column, scale});
         result_.covariance_names.push_back(info.name);
       }
-      if (!estimate.fixed && !result_.covariance_ok) estimate.std = NAN;  // undetermined: say so
+      if (!estimate.fixed && (!result_.covariance_ok || held_for_covariance)) estimate.std = NAN;  // undetermined
       result_.parameters.push_back(estimate);
     });
     result_.covariance.resize(rows.size(), rows.size());

@@ -103,7 +103,7 @@ struct FitResult {
   std::vector<std::string> tolerance_notes;
   // A spline's c1 where the covariance holds it at its fitted value (a near-gauge of the
   // knots: calib/bundle_fit.cc): its std as a share of its value before; NaN otherwise.
-  // `parameters` then report it held, and the covariance leaves it out.
+  // `parameters` then report it free with a NaN std, and the covariance leaves it out.
   double vertex_curvature_std_ratio = NAN;
   double guess_rim_radius_mm = 0.0;  // the guess's rim, for comparison with the fitted sensor's
   // Corner residuals' standard deviation per coordinate (px), from the fit's RMS and its

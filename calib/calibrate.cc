@@ -388,9 +388,12 @@ namespace {
 // else run and, when `kept` is given, copied there. That pass depends on the images, the
 // target, the guess and the detection options, none of which a held-out fold changes (its
 // views are detected with the rest and split off after), so the folds reuse the full set's:
-// on the real dev set it was ~70 % of each calibration's time.
+// on the real dev set it was ~70 % of each calibration's time. `folds_knots`: a held-out
+// fold of a calibration whose default knot choice chose a count (or none: 0), fitted as it
+// was, through the family until the passes end, then as a spline of that count.
 CalibrationResult CalibrateOnce(const CalibrationInput& input, const CalibrationOptions& options,
-                                const DetectedImages* reused, DetectedImages* kept);
+                                const DetectedImages* reused, DetectedImages* kept,
+                                std::optional<int> folds_knots = std::nullopt);
 
 // CalibrationOptions::holdout_folds: the full set's calibration, then one per fold with
 // that fold's views kept out (fitted without them, and refined in the later detection
@@ -417,9 +420,17 @@ CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const
   // fold, and a fold could judge another lens than the calibration written).
   if (!input.guess) fold_options.lens = result.sensor.lens_name();
   if (result.record.profile_choice) fold_options.profile = result.sensor.profile_name();  // the same for the mirror
-  if (const auto& knots = result.record.knot_choice) {  // and its knot count, or none
-    fold_options.profile = result.sensor.profile_name();
-    fold_options.knots = knots->chosen;
+  // ... and its knot count, or none: `--knots auto`'s as asked for, the default's through
+  // the family, as the full set (CalibrateOnce's folds_knots).
+  std::optional<int> folds_knots;
+  if (const auto& knots = result.record.knot_choice) {
+    if (options.knots == kChooseKnots) {
+      fold_options.profile = result.sensor.profile_name();
+      fold_options.knots = knots->chosen;
+    } else {
+      fold_options.profile = knots->base_profile;
+      folds_knots = knots->chosen;
+    }
   }
   if (const auto& tangential = result.record.tangential_choice)  // the same for the tangential terms
     fold_options.tangential = tangential->chosen == kTangentialCandidates[1] ? kTangentialOn : kTangentialOff;
@@ -434,7 +445,7 @@ CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const
   for (size_t f = 0; f < fold_count; ++f) {
     fold_options.holdout_images.clear();
     for (size_t v = f; v < usable.size(); v += fold_count) fold_options.holdout_images.insert(usable[v]);
-    const CalibrationRecord record = CalibrateOnce(input, fold_options, &first_pass, nullptr).record;
+    const CalibrationRecord record = CalibrateOnce(input, fold_options, &first_pass, nullptr, folds_knots).record;
     const HeldOutViews& held = *record.holdout;
     HeldOutFolds::Fold fold;
     fold.images = held.images;
@@ -469,7 +480,7 @@ CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const
 }
 
 CalibrationResult CalibrateOnce(const CalibrationInput& input, const CalibrationOptions& options,
-                                const DetectedImages* reused, DetectedImages* kept) {
+                                const DetectedImages* reused, DetectedImages* kept, std::optional<int> folds_knots) {
   const int sources = !input.image_paths.empty() + !input.images.empty() + input.detections.has_value();
   if (sources != 1) throw InputError("images: give either images (detected here) or detections");
   const bool from_images = !input.detections;
@@ -869,24 +880,41 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   // inner ring no polynomial follows (0.210 against 0.343). Only through the orthographic
   // lens: through the pinhole the spline's free offset over the seen ring slides with the
   // focal length (the dolly zoom m's hold closes; docs/calibrate.md).
-  const bool knots_by_default = profile_unset_or_auto && options.knots == 0 && foldable &&
-                                std::string(fit_start.lens_name()) == "orthographic";
-  std::string knot_fallback;  // why the fitted count is not the folds' choice
-  if ((options.knots == kChooseKnots || knots_by_default) && fit.sensor) {
-    DetectionSet kept = views.detections;
-    kept.images.clear();
-    std::vector<TargetPose> kept_poses;
+  // The views the fit kept (the folds' views): after the passes, some may be left out.
+  DetectionSet kept_views = views.detections;
+  kept_views.images.clear();
+  std::vector<TargetPose> kept_poses;
+  if (fit.sensor)
     for (size_t v = 0; v < views.detections.images.size(); ++v)
       if (fit.view_left_out[v].empty())
-        kept.images.push_back(views.detections.images[v]), kept_poses.push_back(views.poses[v]);
-    // Without a spline: the guess's family, the family chosen, or the polynomial the rim
-    // circle starts a spline from.
-    const std::string guess_profile = input.guess ? input.guess->profile_name() : fit_start.profile_name();
-    const std::string base = guess_profile == "spline" ? "polynomial" : guess_profile;
-    KnotChoice& choice = *(record.knot_choice =
-                               ChooseKnots(fit_start, base, input.target, kept, kept_poses, fit_options, options.progress));
+        kept_views.images.push_back(views.detections.images[v]), kept_poses.push_back(views.poses[v]);
+  const bool knots_by_default = profile_unset_or_auto && options.knots == 0 && !folds_knots &&
+                                static_cast<int>(kept_views.images.size()) >= kMinViewsForFolds &&
+                                std::string(fit_start.lens_name()) == "orthographic";
+  std::string knot_fallback;  // why the fitted count is not the folds' choice
+  std::optional<KnotChoice> knot_choice;
+  // Without a spline: the guess's family, the family chosen, or the polynomial the rim
+  // circle starts a spline from.
+  const std::string guess_profile = input.guess ? input.guess->profile_name() : fit_start.profile_name();
+  const std::string base = guess_profile == "spline" ? "polynomial" : guess_profile;
+  if ((options.knots == kChooseKnots || knots_by_default) && fit.sensor) {
+    try {
+      knot_choice = ChooseKnots(fit_start, base, input.target, kept_views, kept_poses, fit_options, options.progress);
+    } catch (const InputError& error) {
+      if (!knots_by_default) throw;  // asked for: said, as the family and lens choices cannot be
+      warnings.push_back({WarningCode::kProfileNotChosen, "knots",
+                          std::string(error.what()) + "; the " + base + " mirror is kept"});
+    }
+  } else if (folds_knots && fit.sensor) {  // a held-out fold: the full set's count, the only candidate
+    knot_choice = KnotChoice{base, {*folds_knots}, {0.0}, 0, 0, *folds_knots};
+  }
+  if (knot_choice) {
+    KnotChoice& choice = *knot_choice;
+    if (!folds_knots) record.knot_choice = choice;
     const int folds_choice = choice.chosen;
     ValidKnotFit chosen_fit = FitValidKnotCount(choice, base, [&](int knots) {
+      // The family the fit already has (the default's "no spline"): that fit, not again.
+      if (knots == 0 && base == fit_start.profile_name()) return KnotCountFit{fit, fit_start};
       Sensor start = knots > 0 ? ConvertProfile(fit_start, "spline", knots) : ConvertProfile(fit_start, base);
       FitResult result = FitSensor(start, input.target, views.detections, views.poses, WithShapeOf(fit_options, start));
       return KnotCountFit{std::move(result), std::move(start)};
@@ -899,10 +927,14 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     }
     fit_options = WithShapeOf(fit_options, fit_start);
     const int chosen = choice.chosen;
+    if (record.knot_choice) record.knot_choice->chosen = chosen;
+    const bool default_choice = knots_by_default || folds_knots;
     record.start += chosen > 0 ? ", " + std::to_string(chosen) + " knots"
-                    : knots_by_default ? ", no spline"
-                                       : ", the " + base + " mirror";
-    record.start += chosen == folds_choice ? " (chosen by held-out folds)" : " (held-out folds' next choice)";
+                    : default_choice ? ", no spline"
+                                     : ", the " + base + " mirror";
+    record.start += folds_knots ? " (the full set's)"
+                    : chosen == folds_choice ? " (chosen by held-out folds)"
+                                             : " (held-out folds' next choice)";
     knot_fallback = chosen_fit.replaced;
   }
   const DetectionSet& usable = views.detections;

@@ -69,7 +69,10 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
     if (p.fixed) {
       AppendFormatted(out, "  %-16s %14.8g (fixed)\n", p.name.c_str(), p.value);
     } else {
-      AppendFormatted(out, "  %-16s %14.8g +- %.3g\n", p.name.c_str(), p.value, p.std);
+      if (std::isfinite(p.std))
+        AppendFormatted(out, "  %-16s %14.8g +- %.3g\n", p.name.c_str(), p.value, p.std);
+      else
+        AppendFormatted(out, "  %-16s %14.8g (std not determined)\n", p.name.c_str(), p.value);
     }
   }
   AppendFormatted(out, "all fitted corners, outliers included: RMS %.4f px\n", record.rms_all_px);

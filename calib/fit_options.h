@@ -65,6 +65,11 @@ struct FitOptions {
   double robust_loss_px = 1.0;  // robust scale in px (Cauchy, outlier removal, then Huber); 0 = plain least squares
   ceres::Solver::Options solver = DefaultSolverOptions();  // max_num_iterations is per stage
   bool compute_covariance = true;
+  // A spline's c1 that only its knots leave undetermined (a near-gauge: no view sees the
+  // axis) is held for the covariance at its fitted value, reported free with a NaN std
+  // (FitResult::vertex_curvature_std_ratio; calib/bundle_fit.cc). False keeps the
+  // near-singular covariance (tests compare the two).
+  bool hold_weak_vertex_curvature = true;
   // Threads computing the corners' residuals and Jacobians (calib/parallel_evaluation.h);
   // Ceres' own work stays on one (solver.num_threads), so the fit is the same for any count.
   int threads = 1;
