@@ -298,20 +298,20 @@ class FitRun {
     return vertex_curvature_held_ ? std::vector<int>{0} : std::vector<int>{};
   }
 
-  // Whether a spline's fitted c1 is a near-gauge, to be held (at its fitted value) for the
-  // covariance: weakly determined, its std beyond kWeakRelativeStd of its value. No view sees the axis
-  // (the centre shows the camera), and past the first two knot spacings the knots
-  // reproduce any line in s = r^2 (B-splines do), c1 s among them, so only corners inside
-  // those spacings tell c1 from the knots. Where few do, the covariance of that valley is
-  // near-singular and what it predicts is not what the views show: on the OCamCalib
-  // KaidanOmni set (no guess, orthographic, 16 knots) c1's std was 19 %, the knots' grew
-  // linearly to 3.8 mm, and the predicted error read 4.3 px worst (0.6 median) at the
-  // boards' distance, where the corners fit to 0.19 px and held-out folds to 0.21; with c1
-  // held the knots' stds are 0.035 mm and the prediction 0.14 px worst. Holding it moves
-  // nothing: the fit is at its minimum, c1 at its fitted value.
-  // Only where the knots are what c1 trades with: given the knots, c1 is known to within
-  // kWeakRelativeStd (the conditional std, a Schur complement of the covariance). A c1 that
-  // trades with the lens scale or the decenter instead keeps its std and its warning.
+  // Whether a spline's fitted c1 is a near-gauge, to be held at its fitted value for the
+  // covariance. No view sees the axis (the centre shows the camera), and past the first two
+  // knot spacings the knots reproduce any line in s = r^2 (B-splines do), c1 s among them,
+  // so only corners inside those spacings tell c1 from the knots. Where few do, the
+  // covariance of that valley is near-singular and what it predicts is not what the views
+  // show: on the OCamCalib KaidanOmni set (no guess, orthographic, 16 knots) c1's std was
+  // 19 %, the knots' grew linearly to 3.8 mm, and the predicted error read 4.3 px worst
+  // (0.6 median) at the boards' distance, where the corners fit to 0.19 px and held-out
+  // folds to 0.21; with c1 held the knots' stds are 0.035 mm and the prediction 0.14 px
+  // worst. So: c1 weakly determined (its std beyond kWeakRelativeStd of its value) while,
+  // given the knots, known within kWeakRelativeStd (the conditional std, a Schur
+  // complement): the knots are what it trades with. A c1 that trades with the lens scale
+  // or the decenter instead keeps its std and its warning. Holding it moves nothing: the
+  // fit is at its minimum, c1 at its fitted value.
   bool VertexCurvatureIsANearGauge(const std::map<const double*, std::vector<int>>& columns,
                                    const Eigen::MatrixXd& covariance) const {
     using Profile = typename Model::ProfileType;
