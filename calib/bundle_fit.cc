@@ -312,19 +312,20 @@ class FitRun {
   // complement): the knots are what it trades with. A c1 that trades with the lens scale
   // or the decenter instead keeps its std and its warning. Holding it moves nothing: the
   // fit is at its minimum, c1 at its fitted value.
-  bool VertexCurvatureIsANearGauge(const std::map<const double*, std::vector<int>>& columns,
-                                   const Eigen::MatrixXd& covariance) const {
+  // Returns c1's std as a share of its value where it is such a near-gauge, else NaN.
+  double VertexCurvatureNearGaugeStdRatio(const std::map<const double*, std::vector<int>>& columns,
+                                          const Eigen::MatrixXd& covariance) const {
     using Profile = typename Model::ProfileType;
     if constexpr (std::is_same_v<Profile, SplineProfile<double>>) {
-      if (!options_.hold_weak_vertex_curvature) return false;
+      if (!options_.hold_weak_vertex_curvature) return NAN;
       const auto found = columns.find(blocks_.shape.data());
-      if (found == columns.end() || found->second.empty() || found->second[0] < 0) return false;
+      if (found == columns.end() || found->second.empty() || found->second[0] < 0) return NAN;
       const int c1_column = found->second[0];
       std::vector<int> knot_columns;
       for (size_t k = 1; k < found->second.size(); ++k)
         if (found->second[k] >= 0) knot_columns.push_back(found->second[k]);
       const double c1 = std::abs(blocks_.shape[0]), variance = covariance(c1_column, c1_column);
-      if (knot_columns.empty() || !(c1 > 0.0) || !(variance > std::pow(kWeakRelativeStd * c1, 2))) return false;
+      if (knot_columns.empty() || !(c1 > 0.0) || !(variance > std::pow(kWeakRelativeStd * c1, 2))) return NAN;
       const int n = static_cast<int>(knot_columns.size());
       Eigen::MatrixXd knots(n, n);
       Eigen::VectorXd with_c1(n);
@@ -335,9 +336,9 @@ class FitRun {
       // The knots' own covariance may hold a further near-gauge (a constant offset): a
       // pseudo-inverse, not a Cholesky.
       const double given_knots = variance - with_c1.dot(knots.completeOrthogonalDecomposition().solve(with_c1));
-      return given_knots < std::pow(kWeakRelativeStd * c1, 2);
+      return given_knots < std::pow(kWeakRelativeStd * c1, 2) ? std::sqrt(variance) / c1 : NAN;
     }
-    return false;
+    return NAN;
   }
 
   // The lens entries held throughout (by the refine switches), and in stage 1 also the
@@ -601,9 +602,9 @@ class FitRun {
     std::map<const double*, std::vector<int>> columns = Columns();
     Eigen::MatrixXd covariance;
     if (options_.compute_covariance) result_.covariance_ok = Covariance(columns, &covariance);
-    if (result_.covariance_ok && VertexCurvatureIsANearGauge(columns, covariance)) {
-      const int column = columns.at(blocks_.shape.data())[0];
-      result_.vertex_curvature_std_ratio = std::sqrt(covariance(column, column)) / std::abs(blocks_.shape[0]);
+    if (result_.covariance_ok)
+      result_.vertex_curvature_std_ratio = VertexCurvatureNearGaugeStdRatio(columns, covariance);
+    if (std::isfinite(result_.vertex_curvature_std_ratio)) {
       vertex_curvature_held_ = true;
       problem_.SetManifold(blocks_.shape.data(),
                            new ceres::SubsetManifold(static_cast<int>(blocks_.shape.size()), HeldShapeEntries()));
@@ -798,7 +799,7 @@ class FitRun {
   std::vector<Prior> priors_;
   ceres::ResidualBlockId smoothness_ = nullptr;  // a free-form profile's (calib/shape_smoothness.h)
   double prior_noise_px_ = 1.0;  // the corner noise the priors are scaled by; updated between solves
-  bool vertex_curvature_held_ = false;  // a spline's c1, for the covariance (VertexCurvatureIsANearGauge)
+  bool vertex_curvature_held_ = false;  // a spline's c1, for the covariance (VertexCurvatureNearGaugeStdRatio)
   ceres::Solver::Options solver_;
   ProgressReporter progress_;
   IterationProgress iteration_progress_;

@@ -881,15 +881,12 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   // lens: through the pinhole the spline's free offset over the seen ring slides with the
   // focal length (the dolly zoom m's hold closes; docs/calibrate.md).
   // The views the fit kept (the folds' views): after the passes, some may be left out.
-  DetectionSet kept_views = views.detections;
-  kept_views.images.clear();
-  std::vector<TargetPose> kept_poses;
-  if (fit.sensor)
-    for (size_t v = 0; v < views.detections.images.size(); ++v)
-      if (fit.view_left_out[v].empty())
-        kept_views.images.push_back(views.detections.images[v]), kept_poses.push_back(views.poses[v]);
+  const int kept_view_count =
+      fit.sensor ? static_cast<int>(std::count_if(fit.view_left_out.begin(), fit.view_left_out.end(),
+                                                  [](const std::string& why) { return why.empty(); }))
+                 : 0;
   const bool knots_by_default = profile_unset_or_auto && options.knots == 0 && !folds_knots &&
-                                static_cast<int>(kept_views.images.size()) >= kMinViewsForFolds &&
+                                kept_view_count >= kMinViewsForFolds &&
                                 std::string(fit_start.lens_name()) == "orthographic";
   std::string knot_fallback;  // why the fitted count is not the folds' choice
   std::optional<KnotChoice> knot_choice;
@@ -898,6 +895,12 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   const std::string guess_profile = input.guess ? input.guess->profile_name() : fit_start.profile_name();
   const std::string base = guess_profile == "spline" ? "polynomial" : guess_profile;
   if ((options.knots == kChooseKnots || knots_by_default) && fit.sensor) {
+    DetectionSet kept_views = views.detections;
+    kept_views.images.clear();
+    std::vector<TargetPose> kept_poses;
+    for (size_t v = 0; v < views.detections.images.size(); ++v)
+      if (fit.view_left_out[v].empty())
+        kept_views.images.push_back(views.detections.images[v]), kept_poses.push_back(views.poses[v]);
     try {
       knot_choice = ChooseKnots(fit_start, base, input.target, kept_views, kept_poses, fit_options, options.progress);
     } catch (const InputError& error) {
@@ -910,7 +913,6 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   }
   if (knot_choice) {
     KnotChoice& choice = *knot_choice;
-    if (!folds_knots) record.knot_choice = choice;
     const int folds_choice = choice.chosen;
     ValidKnotFit chosen_fit = FitValidKnotCount(choice, base, [&](int knots) {
       // The family the fit already has (the default's "no spline"): that fit, not again.
@@ -927,7 +929,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
     }
     fit_options = WithShapeOf(fit_options, fit_start);
     const int chosen = choice.chosen;
-    if (record.knot_choice) record.knot_choice->chosen = chosen;
+    if (!folds_knots) record.knot_choice = choice;  // a fold's stand-in choice is not reported
     const bool default_choice = knots_by_default || folds_knots;
     record.start += chosen > 0 ? ", " + std::to_string(chosen) + " knots"
                     : default_choice ? ", no spline"
