@@ -52,8 +52,18 @@ std::map<int, Eigen::Vector3d> BoardWarp::CornerPoints(const CalibrationTarget& 
   std::map<int, Eigen::Vector3d> points;
   for (const TargetCorner& c : target.corners()) points[c.id] = c.point_in_target;
   if (!IsZero())
-    for (const auto& [id, basis] : Basis(target)) points[id].z() += OffsetMm(basis);
+    for (const auto& [id, basis] : Basis(target)) points[id].z() += CornerOffsetMm(id, basis);
   return points;
+}
+
+double BoardWarp::CornerOffsetMm(int id, const Eigen::Vector2d& basis) const {
+  const auto relief = relief_mm.find(id);
+  return OffsetMm(basis) + (relief == relief_mm.end() ? 0.0 : relief->second);
+}
+
+bool BoardWarp::IsZero() const {
+  return x_mm == 0.0 && y_mm == 0.0 &&
+         std::all_of(relief_mm.begin(), relief_mm.end(), [](const auto& entry) { return entry.second == 0.0; });
 }
 
 }  // namespace omnical

@@ -4,6 +4,13 @@
 // the corner's position scaled to [-1, 1] over the extent of the board's corners. So x_mm
 // and y_mm are the deflections at the centre relative to the edges, in mm. One warp per
 // board, shared by every view (the same sheet in every image).
+//
+// The relief: optionally each corner's own out-of-plane offset on top of the paraboloid
+// (mm, per corner id; absent ids 0), for a board whose shape the paraboloid cannot follow
+// (a card bent at one corner, a sheet glued unevenly). Shared by every view as well: it
+// is the board's shape, not each view's. On the real Mei set the paraboloid leaves a shape
+// that recurs across views: per-corner offsets learnt on nine views predicted the tenth's
+// corners 22 % better (docs/calibrate.md, "Bent boards").
 #pragma once
 
 #include <Eigen/Core>
@@ -15,7 +22,11 @@
 namespace omnical {
 
 struct BoardWarp {
+  BoardWarp() = default;
+  BoardWarp(double along_x_mm, double along_y_mm) : x_mm(along_x_mm), y_mm(along_y_mm) {}
+
   double x_mm = 0.0, y_mm = 0.0;
+  std::map<int, double> relief_mm;  // per corner id; empty without a relief
 
   // Per corner id the factors (1 - u^2, 1 - v^2) the deflections multiply.
   static std::map<int, Eigen::Vector2d> Basis(const CalibrationTarget& target);
@@ -24,7 +35,9 @@ struct BoardWarp {
   std::map<int, Eigen::Vector3d> CornerPoints(const CalibrationTarget& target) const;
   // The out-of-plane offset of a corner with that basis (mm).
   double OffsetMm(const Eigen::Vector2d& basis) const { return x_mm * basis.x() + y_mm * basis.y(); }
-  bool IsZero() const { return x_mm == 0.0 && y_mm == 0.0; }
+  // The whole out-of-plane offset of corner `id` with that basis (mm): paraboloid and relief.
+  double CornerOffsetMm(int id, const Eigen::Vector2d& basis) const;
+  bool IsZero() const;
 };
 
 // The warp over one board's extent, at any board point (x, y) mm: for rendering bent
@@ -44,6 +57,7 @@ struct WarpedSurface {
 struct BoardWarpEstimate {
   BoardWarp warp;
   double std_x_mm = NAN, std_y_mm = NAN;  // from the fit's covariance (NaN without one)
+  std::map<int, double> relief_std_mm;    // per corner id, when the relief was fitted
 };
 
 }  // namespace omnical

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "calib/board_relief_gauge.h"
 #include "calib/fit_covariance.h"
 #include "calib/parallel_evaluation.h"
 #include "calib/reprojection_cost.h"
@@ -134,6 +135,7 @@ class FitRun {
         evaluation_(options.threads), problem_(ProblemOptions(options.threads > 1 ? &evaluation_ : nullptr)), progress_(options.progress, "fit", 0), iteration_progress_(&progress_) {
     with_warp_ = options.fit_board_warp || !options.board_warp.IsZero();
     warp_mm_ = {options.board_warp.x_mm, options.board_warp.y_mm};
+    with_relief_ = options.fit_board_relief || !options.board_warp.relief_mm.empty();
     result_.guess_rim_radius_mm = guess.rim_radius_mm;
     rotations_.resize(views_);
     translations_.resize(views_);
@@ -145,6 +147,11 @@ class FitRun {
     }
     for (const TargetCorner& c : target.corners()) corner_points_[c.id] = c.point_in_target;
     if (with_warp_) warp_basis_ = BoardWarp::Basis(target);
+    if (with_relief_)
+      for (const TargetCorner& c : target.corners()) {
+        const auto given = options.board_warp.relief_mm.find(c.id);
+        relief_mm_[c.id] = given == options.board_warp.relief_mm.end() ? 0.0 : given->second;
+      }
     // Robust mode: a redescending Cauchy loss while far from the solution (gross outliers
     // get almost no weight, where Huber's linear influence would still pull), then the
     // outliers are removed and the last solve uses Huber. The wrapper swaps every loss.
@@ -208,17 +215,18 @@ class FitRun {
         }
         std::optional<Eigen::Vector2d> basis;
         if (with_warp_) basis = warp_basis_.at(image.corners[i].id);
-        auto functor = std::make_unique<Cost>(guess_, point->second, image.corners[i].pixel, basis);
+        auto functor = std::make_unique<Cost>(guess_, point->second, image.corners[i].pixel, basis, with_relief_);
         std::vector<double*> blocks = blocks_.Pointers();
         blocks.push_back(rotations_[v].data());
         blocks.push_back(translations_[v].data());
         if (with_warp_) blocks.push_back(warp_mm_.data());
+        if (with_relief_) blocks.push_back(&relief_mm_.at(image.corners[i].id));
         double check[2];
         if (!(*functor)(blocks.data(), check)) {
           ++result_.dropped;  // not projectable at the initial guess
           continue;
         }
-        ceres::CostFunction* cost = Cost::Create(guess_, point->second, image.corners[i].pixel, basis);
+        ceres::CostFunction* cost = Cost::Create(guess_, point->second, image.corners[i].pixel, basis, with_relief_);
         if (options_.threads > 1) cost = evaluation_.Wrap(cost, blocks);
         if (options_.view_noise_weights) cost = new ViewWeightedCost(cost, &view_weight_[v]);
         const ceres::ResidualBlockId id = problem_.AddResidualBlock(cost, loss_.get(), blocks);
@@ -286,6 +294,23 @@ class FitRun {
       priors_.push_back({name, block, index, centre, tolerance / scale, scale});
       problem_.AddResidualBlock(new PriorCost(blocks_.BlockSize(block), index, centre, tolerance / scale, &prior_noise_px_),
                                 nullptr, block);
+    }
+    if (options_.fit_board_relief)
+      for (auto& [id, offset_mm] : relief_mm_)
+        if (problem_.HasParameterBlock(&offset_mm)) {
+          problem_.AddResidualBlock(new PriorCost(1, 0, 0.0, kBoardReliefStdMm, &prior_noise_px_), nullptr, &offset_mm);
+          relief_priors_.push_back(&offset_mm);
+        }
+    if (options_.fit_board_relief && !relief_priors_.empty()) {
+      Eigen::MatrixXd shapes(relief_priors_.size(), 3);
+      int row = 0;
+      for (auto& [id, offset_mm] : relief_mm_) {
+        if (!problem_.HasParameterBlock(&offset_mm)) continue;
+        const Eigen::Vector2d& basis = warp_basis_.at(id);
+        shapes.row(row++) << 1.0, basis.x(), basis.y();
+      }
+      relief_gauge_ =
+          problem_.AddResidualBlock(new BoardReliefGaugeCost(shapes, &prior_noise_px_), nullptr, relief_priors_);
     }
     using Profile = typename Model::ProfileType;
     if constexpr (kHasShapeSmoothness<Profile>)
@@ -384,6 +409,8 @@ class FitRun {
     toggle(blocks_.decenter_mm, options_.refine.decenter);
     if (!blocks_.shape.empty()) toggle(blocks_.shape.data(), options_.refine.shape);
     if (with_warp_ && problem_.HasParameterBlock(warp_mm_.data())) toggle(warp_mm_.data(), options_.fit_board_warp);
+    for (auto& [id, offset_mm] : relief_mm_)
+      if (problem_.HasParameterBlock(&offset_mm)) toggle(&offset_mm, options_.fit_board_relief);
   }
   void SetPoses(bool variable) {
     for (size_t v = 0; v < views_; ++v) {
@@ -586,9 +613,11 @@ class FitRun {
 
   // The last stage, to the fit's own tolerances.
   void Finish() {
+    HoldUnseenRelief();
     result_.sigma_px = Statistics();
     // The priors' final weight: the noise the covariance is scaled by (so the two agree).
-    if ((!priors_.empty() || smoothness_) && std::abs(result_.sigma_px - prior_noise_px_) > 0.05 * prior_noise_px_)
+    if ((!priors_.empty() || smoothness_ || !relief_priors_.empty()) &&
+        std::abs(result_.sigma_px - prior_noise_px_) > 0.05 * prior_noise_px_)
       prior_noise_px_ = std::max(1e-6, result_.sigma_px);
     Solve(Precision::kFinal);
     result_.sigma_px = Statistics();
@@ -620,6 +649,20 @@ class FitRun {
       pose.camera_from_target_translation_mm = Eigen::Vector3d(translations_[v][0], translations_[v][1], translations_[v][2]);
       result_.poses.push_back(pose);
     }
+  }
+
+  // A corner whose every observation was cut as an outlier or left out with its view keeps
+  // only its prior: held (at 0, where the prior pulled it) rather than reported as fitted.
+  void HoldUnseenRelief() {
+    if (relief_priors_.empty()) return;
+    std::map<int, int> seen;
+    for (const Residual& r : residuals_)
+      if (!r.outlier && result_.view_left_out[r.view].empty()) ++seen[detections_.images[r.view].corners[r.index].id];
+    for (auto& [id, offset_mm] : relief_mm_)
+      if (problem_.HasParameterBlock(&offset_mm) && !problem_.IsParameterBlockConstant(&offset_mm) && seen[id] == 0) {
+        problem_.SetParameterBlockConstant(&offset_mm);
+        relief_unseen_.insert(id);
+      }
   }
 
   // A parameter that ends many tolerances from its design: the guess, the tolerance or the
@@ -690,11 +733,17 @@ class FitRun {
     // The smoothness prior weighs by the corner noise, as the data do: scaled by 1 / sigma
     // with them it enters as the Gaussian prior it stands for.
     if (smoothness_ && options_.refine.shape) data_blocks.push_back(smoothness_);
+    if (relief_gauge_) data_blocks.push_back(relief_gauge_);  // weighted by the noise as the smoothness is
     std::vector<PriorRow> prior_rows;
     for (const Prior& prior : priors_) {
       const auto found = columns.find(prior.block);
       if (found != columns.end() && found->second[prior.index] >= 0)
         prior_rows.push_back({found->second[prior.index], 1.0 / prior.tolerance});
+    }
+    for (const double* offset_mm : relief_priors_) {
+      const auto found = columns.find(offset_mm);
+      if (found != columns.end() && found->second[0] >= 0)
+        prior_rows.push_back({found->second[0], 1.0 / kBoardReliefStdMm});
     }
     return EstimateCovariance(&problem_, variable_, data_blocks, prior_rows, result_.sigma_px, covariance);
   }
@@ -731,11 +780,21 @@ class FitRun {
 
   void ReportBoardWarp(const std::map<const double*, std::vector<int>>& columns, const Eigen::MatrixXd& covariance) {
     BoardWarpEstimate estimate;
-    estimate.warp = {warp_mm_[0], warp_mm_[1]};
+    estimate.warp.x_mm = warp_mm_[0];
+    estimate.warp.y_mm = warp_mm_[1];
     const auto found = columns.find(warp_mm_.data());
     if (result_.covariance_ok && found != columns.end() && found->second[0] >= 0 && found->second[1] >= 0) {
       estimate.std_x_mm = std::sqrt(std::max(0.0, covariance(found->second[0], found->second[0])));
       estimate.std_y_mm = std::sqrt(std::max(0.0, covariance(found->second[1], found->second[1])));
+    }
+    // Only the corners some view fitted: a corner no view saw has no relief to report.
+    for (const auto& [id, offset_mm] : relief_mm_) {
+      if (!problem_.HasParameterBlock(&offset_mm) || relief_unseen_.count(id)) continue;
+      estimate.warp.relief_mm[id] = offset_mm;
+      const auto column = columns.find(&offset_mm);
+      estimate.relief_std_mm[id] = result_.covariance_ok && column != columns.end() && column->second[0] >= 0
+                                       ? std::sqrt(std::max(0.0, covariance(column->second[0], column->second[0])))
+                                       : NAN;
     }
     result_.board_warp = estimate;
   }
@@ -789,6 +848,13 @@ class FitRun {
   // The board's warp block (calib/board_warp.h): present when fitted or held non-zero.
   bool with_warp_ = false;
   std::array<double, 2> warp_mm_{{0.0, 0.0}};
+  // The board's relief (FitOptions::fit_board_relief), one block per corner id: a map's
+  // values keep their addresses, which the costs hold.
+  bool with_relief_ = false;
+  std::map<int, double> relief_mm_;
+  std::vector<double*> relief_priors_;             // in relief_mm_'s order, as the gauge's blocks
+  ceres::ResidualBlockId relief_gauge_ = nullptr;  // calib/board_relief_gauge.h
+  std::set<int> relief_unseen_;                    // ids whose every corner was cut or left out: held, not reported
   std::map<int, Eigen::Vector2d> warp_basis_;
   std::unique_ptr<ceres::LossFunctionWrapper> loss_;
   ParallelEvaluation evaluation_;  // before the problem: its costs forget themselves here

@@ -284,6 +284,7 @@ FitOptions FitOptionsFor(const CalibrationInput& input, const CalibrationOptions
   if (const std::string why = fit.refine.Hold(options.fixed); !why.empty()) throw InputError(why);
   fit.robust_loss_px = options.loss_px;
   fit.fit_board_warp = options.board_warp;
+  fit.fit_board_relief = options.board_warp && options.board_relief == kReliefOn;
   fit.view_noise_weights = options.view_weights;
   fit.solver.max_num_iterations = options.max_iterations;
   fit.threads = options.threads;
@@ -357,6 +358,11 @@ std::string CalibrationOptions::Check() const {
     return "tangential: off, on or auto (got '" + tangential + "')";
   if ((tangential == kTangentialOn || tangential == kChooseTangential) && HoldsTangential(fixed))
     return "tangential/fixed: tangential " + tangential + " fits p1, p2, which fixed holds";
+  if (!board_relief.empty() && board_relief != kReliefOff && board_relief != kReliefOn && board_relief != kChooseRelief)
+    return "board_relief: off, on or auto (got '" + board_relief + "')";
+  if ((board_relief == kReliefOn || board_relief == kChooseRelief) && !board_warp)
+    return "board_relief: " + board_relief +
+           " fits the relief on top of the board's warp, which board_warp off holds flat";
   if (!(loss_px >= 0.0 && std::isfinite(loss_px))) return "loss_px: must be >= 0 and finite";
   if (max_iterations < 1) return "max_iterations: must be >= 1";
   // Pass 2 re-detects through the first fit; an aprilgrid's later passes through the last.
@@ -437,6 +443,11 @@ CalibrationResult CalibrateWithHeldOutFolds(const CalibrationInput& input, const
   else if (fold_options.tangential.empty())
     fold_options.tangential = kTangentialOff;  // held: no choice was made
   if (fold_options.lens == "orthographic") fold_options.tangential = kTangentialOff;  // which it has none of
+  // And the board's relief.
+  if (const auto& relief = result.record.relief_choice)
+    fold_options.board_relief = relief->chosen == kReliefCandidates[1] ? kReliefOn : kReliefOff;
+  else if (fold_options.board_relief.empty())
+    fold_options.board_relief = kReliefOff;
   std::vector<CalibrationWarning> warnings;  // the folds' own, added to the full set's below
   HeldOutFolds folds;
   folds.views_per_fold = options.holdout_folds;
@@ -639,6 +650,10 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
                      std::to_string(kMinViewsForFolds) + " usable views (" +
                      std::to_string(views.detections.images.size()) +
                      " given), and the orthographic lens kept instead has no tangential distortion; give lens pinhole");
+  if (options.board_relief == kChooseRelief && !foldable)
+    throw InputError(
+        "board_relief: auto chooses by held-out folds, which need >= " + std::to_string(kMinViewsForFolds) +
+        " usable views (" + std::to_string(views.detections.images.size()) + " given); give on or off");
   // A choice by held-out folds starts the fit from the candidate it chose: the start sensor
   // (`guess` refers to it), its fit options and initial poses. The current start is always
   // a choice's candidate, so an unchanged choice copies what is already there (and one no
@@ -702,25 +717,42 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
   // candidate: its score is reused (5 fits fewer).
   const bool choose_tangential =
       options.tangential == kChooseTangential || (tangential_by_default && foldable && !HoldsTangential(options.fixed));
+  // A term switched on or not, by held-out folds: off is the last choice's chosen candidate
+  // (the current fit options), its score reused where a choice ran.
+  auto choose_switch = [&](const std::vector<std::string>& names, FitOptions switched_on, double tolerance,
+                           const std::string& stage) {
+    std::optional<KnownScore> off_score;
+    if (const auto& tangential = record.tangential_choice)
+      off_score = KnownScoreOf(*tangential, tangential->chosen);
+    else if (const auto& profile = record.profile_choice)
+      off_score = KnownScoreOf(*profile, profile->chosen);
+    else if (const auto& lens = record.lens_choice)
+      off_score = KnownScoreOf(*lens, lens->chosen);
+    return ChooseByHeldOutFolds(
+        names,
+        {FoldCandidate{guess, fit_options, views.poses}, FoldCandidate{guess, std::move(switched_on), views.poses}},
+        tolerance, input.target, views.detections, options.threads, stage, options.progress, {off_score, std::nullopt});
+  };
   if (choose_tangential && std::string(guess.lens_name()) == "pinhole") {
     FitOptions fitted = fit_options;
     fitted.refine.tangential = true;
-    std::optional<KnownScore> held_score;
-    if (const auto& profile = record.profile_choice)
-      held_score = KnownScoreOf(*profile, profile->chosen);
-    else if (const auto& lens = record.lens_choice)
-      held_score = KnownScoreOf(*lens, lens->chosen);
-    const NamedChoice& choice = *(record.tangential_choice = ChooseByHeldOutFolds(
-                                      kTangentialCandidates,
-                                      {FoldCandidate{guess, fit_options, views.poses},
-                                       FoldCandidate{guess, std::move(fitted), views.poses}},
-                                      kTangentialScoreTolerance, input.target, views.detections, options.threads,
-                                      "tangential", options.progress, {held_score, std::nullopt}));
+    const NamedChoice& choice = *(record.tangential_choice = choose_switch(kTangentialCandidates, std::move(fitted),
+                                                                           kTangentialScoreTolerance, "tangential"));
     fit_options.refine.tangential = choice.chosen == kTangentialCandidates[1];
     if (!choice.AnyScored() && !tangential_by_default)
       warnings.push_back({WarningCode::kTangentialNotFitted, "tangential",
                           "neither held nor fitted p1, p2 could be fitted to every held-out fold of the views; they "
                           "are held"});
+  }
+  // The board's relief by held-out folds, last, from what the choices above left
+  // (calib/relief_choice.h).
+  const bool choose_relief = options.board_warp && (options.board_relief == kChooseRelief ||
+                                                    (!input.guess && options.board_relief.empty() && foldable));
+  if (choose_relief) {
+    FitOptions relief = fit_options;
+    relief.fit_board_relief = true;
+    record.relief_choice = choose_switch(kReliefCandidates, std::move(relief), kReliefScoreTolerance, "board relief");
+    fit_options.fit_board_relief = record.relief_choice->chosen == kReliefCandidates[1];
   }
   std::optional<Sensor> refit_start;  // the previous pass's fit, where the last fit started
   FitResult fit = FitSensor(guess, input.target, views.detections, views.poses, fit_options);
@@ -752,7 +784,7 @@ CalibrationResult CalibrateOnce(const CalibrationInput& input, const Calibration
       // decoy's size as the sensor does (a 4 x giant among 8 views was no longer refused
       // with the warp free: the fit went 6.5 tolerances off in m and past a valid sphere).
       FitOptions flat_options = fit_options;
-      flat_options.fit_board_warp = false;
+      flat_options.fit_board_warp = flat_options.fit_board_relief = false;
       flat_options.compute_covariance = false;  // the screen reads the poses and sigma only
       flat_options.progress = nullptr;
       FitResult flat;

@@ -23,6 +23,7 @@
 #include "calib/knot_choice.h"
 #include "calib/predicted_error.h"
 #include "calib/profile_choice.h"
+#include "calib/relief_choice.h"
 #include "calib/tangential_choice.h"
 #include "calib/target.h"
 #include "model/progress.h"
@@ -97,6 +98,12 @@ struct CalibrationOptions {
   // as mrcal fits its calobject_warp: hand-held paper bends, and a flat board costs two
   // parameters found ~0 (docs/calibrate.md, "Bent boards").
   bool board_warp = true;
+  // The board's relief (calib/relief_choice.h: each corner's own out-of-plane offset on
+  // top of the warp, shared by every view): "off", "on" (fitted) or kChooseRelief: fitted
+  // where that predicts held-out folds of the views better by more than 1 %. "" (the
+  // default): without a guess kChooseRelief where the views allow folds, else "off". Needs
+  // board_warp. The folds of holdout_folds keep the choice.
+  std::string board_relief;
   // Weight each view's corners by its own noise (FitOptions::view_noise_weights).
   bool view_weights = false;
   // How a checkerboard's corners are refined through the first fit (second detection pass).

@@ -32,7 +32,8 @@ const char* const kHoldoutFoldsDefinition =
     "fitted corners, both all corners, per corner sqrt(mean |e|^2); the written sensor is the full set's fit";
 const char* const kBoardWarpDefinition =
     "the board's out-of-plane shape z = x_mm (1 - u^2) + y_mm (1 - v^2) along its normal, u, v the corner's position "
-    "scaled to [-1, 1] over the board's corners: the deflections at the centre relative to the edges (mm)";
+    "scaled to [-1, 1] over the board's corners: the deflections at the centre relative to the edges (mm); with a "
+    "fitted relief, each corner's own offset (id, offset_mm, std_mm) added to z";
 const char* const kKnotChoiceDefinition =
     "the spline mirror's knot count chosen by held-out folds: the fitted views split into `folds` interleaved folds, "
     "each held out in turn while the rest are calibrated with every candidate count; candidate 0 is base_profile (no spline); held_out_rms_px over every "
@@ -53,6 +54,13 @@ const char* const kProfileChoiceDefinition =
     "candidate family; held_out_rms_px over every held-out corner of every fold (poses fitted, sensor held), per "
     "corner sqrt(mean |e|^2), null where a fold failed (no fit, no valid sensor, or a held-out view or corner without "
     "a residual); chosen: the first candidate within 1 % of the lowest, the first where none scored";
+const char* const kReliefChoiceDefinition =
+    "whether the board's relief (each corner's own out-of-plane offset on top of the warp, board_warp.relief) is "
+    "fitted (candidate warp+relief) or not (warp), chosen by held-out folds on the first detection pass's corners: "
+    "the usable views split into `folds` interleaved folds, each held out in turn while the rest are calibrated both "
+    "ways, the board's shape held for the held-out views; held_out_rms_px over every held-out corner of every fold "
+    "(poses fitted, sensor held), per corner sqrt(mean |e|^2), null where a fold failed; chosen: the first candidate "
+    "within 1 % of the lowest, the first where none scored";
 const char* const kTangentialChoiceDefinition =
     "whether the pinhole's tangential distortion p1, p2 is fitted (candidate fitted) or held at the start's values "
     "(held), chosen by held-out folds on the first detection pass's corners: the usable views split into `folds` "
@@ -162,9 +170,20 @@ json ToJson(const CalibrationRecord& r) {
                        {"inlier_fraction", r.rim_circle->inlier_fraction},
                        {"rms_px", r.rim_circle->rms_px}};
   for (const auto& [name, s] : r.leave_one_out) j["leave_one_out"][name] = {{"min", s.min}, {"max", s.max}, {"std", s.std}};
-  if (const auto& w = r.board_warp)
+  if (const auto& w = r.board_warp) {
     j["board_warp"] = {{"x_mm", w->warp.x_mm}, {"y_mm", w->warp.y_mm}, {"std_x_mm", NumberOrNull(w->std_x_mm)},
                        {"std_y_mm", NumberOrNull(w->std_y_mm)}, {"definition", kBoardWarpDefinition}};
+    if (!w->warp.relief_mm.empty()) {
+      json relief = json::array();
+      for (const auto& [id, offset_mm] : w->warp.relief_mm) {
+        const auto std_mm = w->relief_std_mm.find(id);
+        relief.push_back({{"id", id},
+                          {"offset_mm", offset_mm},
+                          {"std_mm", NumberOrNull(std_mm == w->relief_std_mm.end() ? NAN : std_mm->second)}});
+      }
+      j["board_warp"]["relief"] = relief;
+    }
+  }
   if (const auto& k = r.knot_choice) {
     json& out = j["knot_choice"] = FoldChoiceJson(*k, kKnotChoiceDefinition);
     out["base_profile"] = k->base_profile;
@@ -172,6 +191,7 @@ json ToJson(const CalibrationRecord& r) {
   if (const auto& l = r.lens_choice) j["lens_choice"] = FoldChoiceJson(*l, kLensChoiceDefinition);
   if (const auto& p = r.profile_choice) j["profile_choice"] = FoldChoiceJson(*p, kProfileChoiceDefinition);
   if (const auto& t = r.tangential_choice) j["tangential_choice"] = FoldChoiceJson(*t, kTangentialChoiceDefinition);
+  if (const auto& b = r.relief_choice) j["relief_choice"] = FoldChoiceJson(*b, kReliefChoiceDefinition);
   if (const auto& h = r.holdout) {
     json& out = j["holdout"];
     out["views"] = h->images;
@@ -296,8 +316,18 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
     if (j.contains("rms_all_px")) r.rms_all_px = NumberOrNan(at("rms_all_px"));
     if (j.contains("board_warp")) {
       const json& w = at("board_warp");
-      r.board_warp = BoardWarpEstimate{{w.at("x_mm").get<double>(), w.at("y_mm").get<double>()},
-                                       NumberOrNan(w.at("std_x_mm")), NumberOrNan(w.at("std_y_mm"))};
+      BoardWarpEstimate estimate;
+      estimate.warp.x_mm = w.at("x_mm").get<double>();
+      estimate.warp.y_mm = w.at("y_mm").get<double>();
+      estimate.std_x_mm = NumberOrNan(w.at("std_x_mm"));
+      estimate.std_y_mm = NumberOrNan(w.at("std_y_mm"));
+      if (w.contains("relief"))
+        for (const json& corner : w.at("relief")) {
+          const int id = corner.at("id").get<int>();
+          estimate.warp.relief_mm[id] = corner.at("offset_mm").get<double>();
+          estimate.relief_std_mm[id] = NumberOrNan(corner.at("std_mm"));
+        }
+      r.board_warp = estimate;
     }
     if (j.contains("knot_choice")) {
       const json& k = at("knot_choice");
@@ -309,6 +339,8 @@ CalibrationRecord FromJson(const json& j, const std::string& name) {
       r.profile_choice = FoldChoiceFromJson<NamedChoice>(at("profile_choice"), name, "profile_choice");
     if (j.contains("tangential_choice"))
       r.tangential_choice = FoldChoiceFromJson<NamedChoice>(at("tangential_choice"), name, "tangential_choice");
+    if (j.contains("relief_choice"))
+      r.relief_choice = FoldChoiceFromJson<NamedChoice>(at("relief_choice"), name, "relief_choice");
     if (j.contains("holdout")) {
       const json& h = at("holdout");
       HeldOutViews held;

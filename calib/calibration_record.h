@@ -54,6 +54,8 @@ struct CalibrationRecord {
   // When chosen (CalibrationOptions::tangential = kChooseTangential, or unset without a
   // guess; a pinhole).
   std::optional<NamedChoice> tangential_choice;
+  // Whether the board's relief was fitted, chosen by held-out folds (calib/relief_choice.h).
+  std::optional<NamedChoice> relief_choice;
   // The two halves' calibrations compared (CalibrationOptions::cross_validate). The diff's
   // per-pixel vectors are kept in memory for the report's figure; the file has the summary.
   struct CrossValidationRecord {

@@ -79,6 +79,17 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
   if (const auto& warp = record.board_warp)
     AppendFormatted(out, "board warp: %.3f +- %.3f mm along x, %.3f +- %.3f mm along y (deflection at the centre)\n",
                     warp->warp.x_mm, warp->std_x_mm, warp->warp.y_mm, warp->std_y_mm);
+  if (const auto& warp = record.board_warp; warp && !warp->warp.relief_mm.empty()) {
+    double square = 0.0, largest = 0.0;
+    for (const auto& entry : warp->warp.relief_mm) {
+      square += entry.second * entry.second;
+      largest = std::max(largest, std::abs(entry.second));
+    }
+    AppendFormatted(
+        out,
+        "board relief (each corner's own offset on top of the warp): RMS %.3f mm, largest %.3f mm over %zu corners\n",
+        std::sqrt(square / warp->warp.relief_mm.size()), largest, warp->warp.relief_mm.size());
+  }
   for (const CalibrationRecord::PredictedErrorSummary& p : record.predicted_error) {
     if (std::isfinite(p.n_rim_radii)) {
       AppendFormatted(out, "predicted projection error at %.0f mm (n = %.2f): ", p.distance_mm, p.n_rim_radii);
@@ -97,6 +108,7 @@ std::string CalibrationSummaryText(const CalibrationResult& result, const std::s
   if (const auto& lens = record.lens_choice) AppendNamedChoice("lens", *lens, &out);
   if (const auto& profile = record.profile_choice) AppendNamedChoice("mirror family", *profile, &out);
   if (const auto& tangential = record.tangential_choice) AppendNamedChoice("tangential terms p1, p2", *tangential, &out);
+  if (const auto& relief = record.relief_choice) AppendNamedChoice("board shape", *relief, &out);
   if (const auto& held = record.holdout)
     AppendFormatted(out, "held out: %zu views, %d corners: RMS %.4f px (training %.4f px, ratio %.2f)\n",
                     held->images.size(), held->corners, held->rms_px, record.rms_all_px, held->rms_px / record.rms_all_px);

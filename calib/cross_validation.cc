@@ -69,7 +69,7 @@ HeldOutViews EvaluateHeldOutViews(const Sensor& sensor, const CalibrationTarget&
   options.tolerances.clear();
   options.design.clear();
   options.compute_covariance = false;
-  options.fit_board_warp = false;  // held at options.board_warp, the training fit's
+  options.fit_board_warp = options.fit_board_relief = false;  // held at options.board_warp, the training fit's
   options.view_rms_ratio = HUGE_VAL;
   options.progress = nullptr;
   const FitResult fit = FitSensor(wide, target, posed, poses, options);

@@ -136,6 +136,9 @@ std::string FitOptions::Check() const {
   // The threads work through an evaluation callback, which Ceres refuses with inner iterations.
   if (threads > 1 && solver.use_inner_iterations) return "threads: more than 1 needs solver.use_inner_iterations off";
   if (!std::isfinite(board_warp.x_mm) || !std::isfinite(board_warp.y_mm)) return "board_warp: must be finite";
+  for (const auto& [id, offset_mm] : board_warp.relief_mm)
+    if (!std::isfinite(offset_mm)) return "board_warp: relief of corner " + std::to_string(id) + " must be finite";
+  if (fit_board_relief && !fit_board_warp) return "fit_board_relief: needs fit_board_warp";
   if (std::string why; !solver.IsValid(&why)) return "solver: " + why;
   return {};
 }

@@ -60,6 +60,11 @@ ceres::Solver::Options DefaultSolverOptions();
 constexpr double kMinViewWeight = 0.1;
 constexpr double kMaxViewWeight = 10.0;
 
+// The prior std of each corner's relief (FitOptions::fit_board_relief): a bent card's
+// departure from the paraboloid is a fraction of a mm (the Mei set's, fitted: see
+// docs/calibrate.md); 1 mm leaves that to the data and still settles the gauge.
+constexpr double kBoardReliefStdMm = 1.0;
+
 struct FitOptions {
   RefineOptions refine;
   double robust_loss_px = 1.0;  // robust scale in px (Cauchy, outlier removal, then Huber); 0 = plain least squares
@@ -116,6 +121,10 @@ struct FitOptions {
   // The board's out-of-plane warp (calib/board_warp.h): fitted with the sensor when
   // fit_board_warp, else held at board_warp (zero: a flat board).
   bool fit_board_warp = false;
+  // The board's relief (BoardWarp::relief_mm) fitted too, each corner's offset under a
+  // Gaussian prior of kBoardReliefStdMm (it also settles the relief's gauge: a plane of
+  // offsets is a tilt of the board every pose takes up). Needs fit_board_warp.
+  bool fit_board_relief = false;
   BoardWarp board_warp;
   // Stage "fit", one step per solver iteration; returning false cancels (Cancelled).
   ProgressCallback progress;

@@ -11,6 +11,8 @@
 //   translation 3: camera_from_target (mm)
 //   warp        2 (mm), only when the cost is created with a warp basis: the board's
 //               out-of-plane deflection at its centre along its x and y axes (BoardWarp)
+//   relief      1 (mm), only when created with_relief: this corner's own out-of-plane
+//               offset on top of the warp (BoardWarp::relief_mm)
 // Residual: predicted minus observed pixel (2). Evaluation fails (returns false) where the
 // optics have no reflection point: Ceres then treats the step as invalid.
 #pragma once
@@ -37,12 +39,13 @@ class ReprojectionCost {
   // base: the rim, image size, the profile's parameter count (a tabulated profile's table).
   // warp_basis: the corner's BoardWarp::Basis when the warp block is present.
   ReprojectionCost(const Model& base, const Eigen::Vector3d& point_in_target_mm, const Eigen::Vector2d& observed_px,
-                   const std::optional<Eigen::Vector2d>& warp_basis = std::nullopt)
+                   const std::optional<Eigen::Vector2d>& warp_basis = std::nullopt, bool with_relief = false)
       : base_(base),
         point_in_target_mm_(point_in_target_mm),
         observed_px_(observed_px),
         warp_basis_(warp_basis),
-        block_sizes_(BlockSizes(base, warp_basis.has_value())),
+        with_relief_(with_relief),
+        block_sizes_(BlockSizes(base, warp_basis.has_value(), with_relief)),
         last_scalars_(std::accumulate(block_sizes_.begin(), block_sizes_.end(), size_t{0})) {
     // The corner was detected, so its reflection lies on the mirror; iterates may stray a
     // little past the rim, where the profile is still defined.
@@ -62,6 +65,7 @@ class ReprojectionCost {
     const Eigen::Quaternion<T> rotation(p[next][3], p[next][0], p[next][1], p[next][2]);
     Vec3<T> in_target = point_in_target_mm_.cast<T>();
     if (warp_basis_) in_target.z() += p[next + 2][0] * T(warp_basis_->x()) + p[next + 2][1] * T(warp_basis_->y());
+    if (with_relief_) in_target.z() += p[next + (warp_basis_ ? 3 : 2)][0];
     const Vec3<T> in_camera = rotation * in_target + Vec3<T>(p[next + 1][0], p[next + 1][1], p[next + 1][2]);
     Vec3<T> mirror_point;
     // The corner was detected: no image-bounds or occlusion test, only the optics.
@@ -75,22 +79,24 @@ class ReprojectionCost {
   }
 
   // The blocks' sizes, in the order above.
-  static std::vector<int> BlockSizes(const Model& base, bool with_warp = false) {
+  static std::vector<int> BlockSizes(const Model& base, bool with_warp = false, bool with_relief = false) {
     std::vector<int> sizes = {Lens<double>::kNumParams, 1, 2, 2};
     if (base.mirror.NumParams() > 0) sizes.push_back(base.mirror.NumParams());
     sizes.push_back(4);
     sizes.push_back(3);
     if (with_warp) sizes.push_back(2);
+    if (with_relief) sizes.push_back(1);
     return sizes;
   }
 
   // Automatic derivatives (Jets through the implicit solve: model/catadioptric.h).
   static ceres::CostFunction* Create(const Model& base, const Eigen::Vector3d& point_in_target_mm,
                                      const Eigen::Vector2d& observed_px,
-                                     const std::optional<Eigen::Vector2d>& warp_basis = std::nullopt) {
+                                     const std::optional<Eigen::Vector2d>& warp_basis = std::nullopt,
+                                     bool with_relief = false) {
     auto* cost = new ceres::DynamicAutoDiffCostFunction<ReprojectionCost, 8>(
-        new ReprojectionCost(base, point_in_target_mm, observed_px, warp_basis));
-    for (int size : BlockSizes(base, warp_basis.has_value())) cost->AddParameterBlock(size);
+        new ReprojectionCost(base, point_in_target_mm, observed_px, warp_basis, with_relief));
+    for (int size : BlockSizes(base, warp_basis.has_value(), with_relief)) cost->AddParameterBlock(size);
     cost->SetNumResiduals(2);
     return cost;
   }
@@ -121,6 +127,7 @@ class ReprojectionCost {
   Eigen::Vector3d point_in_target_mm_;
   Eigen::Vector2d observed_px_;
   std::optional<Eigen::Vector2d> warp_basis_;
+  bool with_relief_ = false;
   std::vector<int> block_sizes_;
   // The last call's parameter values and reflection point (model/catadioptric.h,
   // SolvedReflection): the Jet passes of one Jacobian, and a Jacobian after a plain residual

@@ -181,6 +181,18 @@ TEST(CalibrateApi, RecordRoundTripsThroughCalibrationJson) {
   EXPECT_EQ(profile_back.profile_choice->held_out_rms_px, (std::vector<double>{0.21, 0.20}));
   EXPECT_EQ(profile_back.tangential_choice->chosen, "fitted");
   EXPECT_EQ(CalibrationJsonText(profile_back), CalibrationJsonText(chosen));
+  // And the board's relief: its choice, and each corner's offset with its std (one not determined).
+  chosen.relief_choice = NamedChoice{kReliefCandidates, {0.31, 0.25}, 480, 5, "warp+relief"};
+  BoardWarpEstimate relief_warp{BoardWarp{-1.1, 1.0}, 0.1, 0.09, {{3, 0.02}, {7, NAN}}};
+  relief_warp.warp.relief_mm = {{3, 0.5}, {7, -0.25}};
+  chosen.board_warp = relief_warp;
+  const CalibrationRecord relief_back = ParseCalibrationJson(CalibrationJsonText(chosen), "memory");
+  ASSERT_TRUE(relief_back.relief_choice.has_value() && relief_back.board_warp.has_value());
+  EXPECT_EQ(relief_back.relief_choice->chosen, "warp+relief");
+  EXPECT_EQ(relief_back.board_warp->warp.relief_mm, relief_warp.warp.relief_mm);
+  EXPECT_EQ(relief_back.board_warp->relief_std_mm.at(3), 0.02);
+  EXPECT_TRUE(std::isnan(relief_back.board_warp->relief_std_mm.at(7)));
+  EXPECT_EQ(CalibrationJsonText(relief_back), CalibrationJsonText(chosen));
   // Images no view was made of, with the reason.
   chosen.views_skipped = {{"a.png", "no tag of the target found"}, {"b.png", "cannot read the image"}};
   const CalibrationRecord skipped_back = ParseCalibrationJson(CalibrationJsonText(chosen), "memory");
@@ -452,6 +464,19 @@ TEST(CalibrateApi, WithoutAGuessTheLensIsChosenWhereTheViewsAllowFolds) {
     EXPECT_NE(chosen.record.start.find(said), std::string::npos) << chosen.record.start;
     EXPECT_STREQ(chosen.sensor.profile_name(), knots->chosen > 0 ? "spline" : profile.chosen.c_str());
   }
+  // The board's relief is chosen last, whatever the lens (calib/relief_choice.h): the warp
+  // alone is the previous choice's candidate, its score reused. These renders' board is flat.
+  ASSERT_TRUE(chosen.record.relief_choice.has_value());
+  const NamedChoice& relief = *chosen.record.relief_choice;
+  EXPECT_EQ(relief.candidates, kReliefCandidates);
+  EXPECT_EQ(relief.folds, lens.folds);
+  const NamedChoice& before_relief = chosen.record.tangential_choice ? *chosen.record.tangential_choice : profile;
+  const size_t before_chosen =
+      std::find(before_relief.candidates.begin(), before_relief.candidates.end(), before_relief.chosen) -
+      before_relief.candidates.begin();
+  EXPECT_EQ(relief.held_out_rms_px[0], before_relief.held_out_rms_px[before_chosen]);
+  ASSERT_TRUE(chosen.record.board_warp.has_value());
+  EXPECT_EQ(chosen.record.board_warp->warp.relief_mm.empty(), relief.chosen == kReliefCandidates[0]);
   for (const CalibrationWarning& w : chosen.warnings) {
     EXPECT_NE(w.code, WarningCode::kTangentialNotFitted) << w.text;
     EXPECT_NE(w.code, WarningCode::kLensNotChosen) << w.text;
@@ -464,12 +489,18 @@ TEST(CalibrateApi, WithoutAGuessTheLensIsChosenWhereTheViewsAllowFolds) {
   EXPECT_FALSE(few.record.tangential_choice.has_value());
   EXPECT_FALSE(few.record.profile_choice.has_value());
   EXPECT_FALSE(few.record.knot_choice.has_value());
+  EXPECT_FALSE(few.record.relief_choice.has_value());
+  ASSERT_TRUE(few.record.board_warp.has_value());
+  EXPECT_TRUE(few.record.board_warp->warp.relief_mm.empty());
   EXPECT_STREQ(few.sensor.profile_name(), "polynomial");
   EXPECT_STREQ(few.sensor.lens_name(), "orthographic");
   EXPECT_EQ(few.record.start, "rim circle, polynomial mirror, orthographic lens");
   options.tangential = kTangentialOn;  // p1, p2 asked for where the lens cannot be chosen: refused, not dropped
   ExpectRefused(input, options, "tangential: the lens is chosen by held-out folds, which need >= 4 usable views");
   options.tangential.clear();
+  options.board_relief = kChooseRelief;
+  ExpectRefused(input, options, "board_relief: auto chooses by held-out folds, which need >= 4 usable views (3 given)");
+  options.board_relief.clear();
   options.profile = kChooseProfile;
   ExpectRefused(input, options, "profile: choosing by held-out folds needs >= 4 usable views");
   options.profile.clear();

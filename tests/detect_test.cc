@@ -1283,7 +1283,7 @@ TEST(CheckerboardCompletion, PredictsTheMissingCornersThroughTheFit) {
   const CalibrationTarget& target = *scene.views[0].targets[0].target;
   DetectionSet fitted;
   FitResult fit;
-  fit.board_warp = BoardWarpEstimate{scene.views[0].targets[0].surface.warp};
+  fit.board_warp = BoardWarpEstimate{scene.views[0].targets[0].surface.warp, NAN, NAN, {}};
   ASSERT_FALSE(fit.board_warp->warp.IsZero());
   std::map<std::string, std::map<int, Eigen::Vector2d>> truth_px;
   const std::set<int> removed = {0, 9, 20, 47};
@@ -1351,7 +1351,7 @@ TEST(CheckerboardCompletion, PredictsTheTagsTheRimCutsThroughTheFit) {
   ASSERT_EQ(view.name.substr(view.name.size() - 4), "rim0") << view.name;
   const CalibrationTarget& target = *view.targets[0].target;
   FitResult fit;
-  fit.board_warp = BoardWarpEstimate{view.targets[0].surface.warp};
+  fit.board_warp = BoardWarpEstimate{view.targets[0].surface.warp, NAN, NAN, {}};
   const PlacedTarget& placed = view.targets[0];
   fit.poses.push_back({Eigen::Quaterniond(placed.camera_from_target_rotation), placed.camera_from_target_translation_mm});
   fit.view_left_out.push_back("");

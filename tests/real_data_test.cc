@@ -158,6 +158,23 @@ TEST(RealImages, MeiParabolicDetectsAndCalibrates) {
   // asphere's is fitted, and within 1 % of it (a 2 % gap would change the choice).
   EXPECT_EQ(profile.held_out_rms_px[0], lens.held_out_rms_px[0]);
   EXPECT_NEAR(profile.held_out_rms_px[1] / profile.held_out_rms_px[0], 1.0, 0.01);
+  // Last, the board's relief (calib/relief_choice.h): this hand-held card has a shape the
+  // paraboloid warp does not follow, which recurs in every view; learnt on the training
+  // views it predicts the held-out ones better (measured on these corners 0.3838 -> 0.3635
+  // px, 5 %; 0.3098 -> 0.2518 on the edge-refined ones), and it is fitted. The warp alone is
+  // the family choice's candidate, its score reused.
+  ASSERT_TRUE(chosen.relief_choice.has_value());
+  const NamedChoice& relief = *chosen.relief_choice;
+  EXPECT_EQ(relief.chosen, "warp+relief");
+  EXPECT_EQ(relief.held_out_rms_px[0], profile.held_out_rms_px[0]);
+  EXPECT_LT(relief.held_out_rms_px[1], 0.97 * relief.held_out_rms_px[0]);
+  ASSERT_TRUE(chosen.board_warp.has_value());
+  EXPECT_EQ(chosen.board_warp->warp.relief_mm.size(), 48u);
+  // Determined by the corners, not by the relief's 1 mm prior (measured 0.20-0.34 mm; the
+  // warp's 0.07 mm, against 0.39 before its paraboloids were held out of the relief).
+  for (const auto& [id, std_mm] : chosen.board_warp->relief_std_mm) EXPECT_LT(std_mm, 0.5) << "corner " << id;
+  EXPECT_LT(chosen.board_warp->std_x_mm, 0.2);
+  EXPECT_LT(chosen.board_warp->std_y_mm, 0.2);
 }
 
 // The issue's bounds on the real dev set, calibrated as a user would (`omnical calibrate
@@ -199,17 +216,24 @@ TEST(RealImages, MeiParabolicGeneralisesWithinTheIssuesBounds) {
   std::mutex mutex;
   options.progress = [&](const ProgressUpdate& update) {
     const std::lock_guard<std::mutex> lock(mutex);
-    if (update.done == 0 && (update.stage == "lens" || update.stage == "profile" || update.stage == "tangential"))
+    if (update.done == 0 && (update.stage == "lens" || update.stage == "profile" || update.stage == "tangential" ||
+                             update.stage == "board relief"))
       choices.emplace_back(update.stage, update.total);
     return true;
   };
   const CalibrationResult full = Calibrate(input, options);
   const CalibrationRecord& record = full.record;
-  EXPECT_EQ(choices, (std::vector<std::pair<std::string, long>>{{"lens", 10}, {"profile", 5}}));
+  EXPECT_EQ(choices, (std::vector<std::pair<std::string, long>>{{"lens", 10}, {"profile", 5}, {"board relief", 5}}));
   EXPECT_EQ(record.views_left_out.size(), 0u);
   EXPECT_EQ(record.observations, 480);
   EXPECT_LE(record.outliers, 0.01 * record.observations);
-  EXPECT_LT(record.rms_all_px, 0.35);
+  // The issue's first bound: over all corners within mrcal's 10-knot splined model's 0.239
+  // px on the same corners (docs/calibration-vs-mrcal.md; 0.241 on the corners as refined
+  // through a fit with the relief), which the board's relief meets (measured 0.216 px;
+  // 0.285 with the warp alone).
+  ASSERT_TRUE(record.relief_choice.has_value());
+  EXPECT_EQ(record.relief_choice->chosen, "warp+relief");
+  EXPECT_LE(record.rms_all_px, 0.239);
   ASSERT_TRUE(record.cross_validation);
   EXPECT_DOUBLE_EQ(record.cross_validation->diff.distance_mm, 2000.0);
   EXPECT_LE(record.cross_validation->diff.rms_px, 0.35);

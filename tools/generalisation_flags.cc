@@ -31,6 +31,11 @@ void AddGeneralisationFlags(CLI::App& sub, CalibrationOptions* library) {
                  "the default with a guess), on (fitted) or auto (the default without one): fitted only where that "
                  "predicts held-out folds better by > 1 % (calibration.json tangential_choice)")
       ->check(CLI::IsMember({"off", "on", "auto"}));
+  sub.add_option("--board-relief", library->board_relief,
+                 "The board's relief: each corner's own out-of-plane offset on top of the warp, shared by every view "
+                 "(a card bent at one corner): off, on (fitted) or auto (the default without a guess): fitted only "
+                 "where that predicts held-out folds better by > 1 % (calibration.json relief_choice)")
+      ->check(CLI::IsMember({"off", "on", "auto"}));
   sub.add_flag("--leave-one-out", library->leave_one_out,
                "Also fit without each image in turn; calibration.json gets each parameter's spread");
 }

@@ -590,6 +590,7 @@ calibrate_start_error calibrate_no_source "give either --images" --target "$grid
 calibrate_start_error calibrate_no_rim "no mirror rim circle found" --target "$grid" --images "$blank"
 calibrate_start_error calibrate_lens_with_guess "lens: the guess has its lens (pinhole)" --target "$grid" --detections "$work/det.json" --sensor "$guess" --lens pinhole
 calibrate_start_error calibrate_tangential_orthographic "tangential: the orthographic lens has no tangential distortion (p1, p2 are a pinhole's); give lens pinhole or auto" --target "$grid" --detections "$work/det.json" --lens orthographic --tangential on
+calibrate_start_error calibrate_relief_without_warp "board_relief: on fits the relief on top of the board's warp, which board_warp off holds flat" --target "$grid" --detections "$work/det.json" --board-relief on --no-board-warp
 calibrate_start_error calibrate_hyperboloid_needs_guess "a hyperboloid needs a guess" --target "$grid" --detections "$work/det.json" --profile hyperboloid
 # A corrupt image is reported and skipped; the others are detected.
 mkdir -p "$work/mixed" && cp "$rendered/near-front.png" "$rendered/near000.png" "$work/mixed/" && printf 'not a png' >"$work/mixed/broken.png"

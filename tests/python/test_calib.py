@@ -349,6 +349,13 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
     assert close(warp["x_mm"], cli["board_warp"]["x_mm"]) and close(warp["std_y_mm"], cli["board_warp"]["std_y_mm"])
     assert omnical.calibrate(TARGET, detections=detections, guess=GUESS, max_iterations=1, board_warp=False).board_warp is None
     assert omnical.calibrate(TARGET, detections=detections, guess=GUESS, max_iterations=1).board_warp is not None
+    # The board's relief asked for: each detected corner's offset and std, none chosen by folds.
+    relief = omnical.calibrate(TARGET, detections=detections, guess=GUESS, max_iterations=20, board_relief="on")
+    offsets = relief.board_warp["relief"]
+    detected = {int(i) for view in omnical.Detections.load(detections).images for i in view.ids}
+    # Every corner some view fitted (one cut from every view it was in would be left out).
+    assert relief.relief_choice is None and set(offsets) <= detected and len(offsets) >= 0.9 * len(detected)
+    assert all(np.isfinite(offset) and 0.0 < std < 1.0 for offset, std in offsets.values()), offsets
     summary = result.summary()  # what the CLI prints without -q
     assert f"RMS {result.rms_px:.4f} px" in summary and f"ratio {held['rms_px'] / result.rms_all_px:.2f}" in summary
     assert f"{warp['x_mm']:.3f} +- {warp['std_x_mm']:.3f} mm along x" in summary and "differ at 1500 mm" in summary
@@ -397,6 +404,14 @@ def test_holdout_cross_validation_and_diff_equal_cli(runs, tmp_path):
     with pytest.raises(omnical.InputError) as raised:
         omnical.calibrate(TARGET, detections=detections, guess=GUESS, holdout=40)
     assert str(raised.value) == few_views and "holdout: 40 views held out" in few_views
+    # The board's relief on a board held flat: the same sentence from both front ends.
+    flat_relief = cli_error(run_cli("calibrate", "--target", TARGET, "--detections", detections, "--sensor", GUESS,
+                                    "--board-relief", "on", "--no-board-warp", "--out", tmp_path / "bad"))
+    with pytest.raises(omnical.InputError) as raised:
+        omnical.calibrate(TARGET, detections=detections, guess=GUESS, board_relief="on", board_warp=False)
+    assert str(raised.value) == flat_relief and "board_relief: on fits the relief" in flat_relief
+    with pytest.raises(omnical.InputError, match=r"^board_relief: off, on or auto \(got 'maybe'\)"):
+        omnical.calibrate(TARGET, detections=detections, guess=GUESS, board_relief="maybe")
     # profile='auto' chooses an unknown mirror's family: refused with a guess, in both front ends.
     auto_with_guess = cli_error(run_cli("calibrate", "--target", TARGET, "--detections", detections, "--sensor", GUESS,
                                         "--profile", "auto", "--out", tmp_path / "bad"))

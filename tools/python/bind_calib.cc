@@ -249,11 +249,17 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
       [record](const Holder& holder) -> py::object {
         const auto& w = record(holder).board_warp;
         if (!w) return py::none();
+        py::dict relief;
+        for (const auto& [id, offset_mm] : w->warp.relief_mm) {
+          const auto std_mm = w->relief_std_mm.find(id);
+          relief[py::int_(id)] = py::make_tuple(offset_mm, std_mm == w->relief_std_mm.end() ? NAN : std_mm->second);
+        }
         return py::dict("x_mm"_a = w->warp.x_mm, "y_mm"_a = w->warp.y_mm, "std_x_mm"_a = w->std_x_mm,
-                        "std_y_mm"_a = w->std_y_mm);
+                        "std_y_mm"_a = w->std_y_mm, "relief"_a = relief);
       },
-      "The board's fitted warp (board_warp=True, the default): dict x_mm, y_mm (deflection at the centre along each board axis) "
-      "and their std_x_mm, std_y_mm; None unless fitted.");
+      "The board's fitted warp (board_warp=True, the default): dict x_mm, y_mm (deflection at the centre along each "
+      "board axis) and their std_x_mm, std_y_mm, and relief: corner id -> (offset_mm, std_mm), each corner's own "
+      "out-of-plane offset on top of the warp (empty unless the relief was fitted: board_relief); None unless fitted.");
   cls.def_property_readonly(
       "knot_choice",
       [record](const Holder& holder) -> py::object {
@@ -283,6 +289,11 @@ void AddRecordFields(py::class_<Holder>& cls, Get record) {
       [record, named_choice](const Holder& holder) { return named_choice(record(holder).tangential_choice); },
       "Whether a pinhole's p1, p2 are fitted, chosen by held-out folds (tangential='auto', or unset without a guess): dict candidates (held, "
       "fitted), held_out_rms_px, held_out_corners, folds, chosen; None unless chosen.");
+  cls.def_property_readonly(
+      "relief_choice",
+      [record, named_choice](const Holder& holder) { return named_choice(record(holder).relief_choice); },
+      "Whether the board's relief is fitted, chosen by held-out folds (board_relief='auto', or unset without a guess): "
+      "dict candidates (warp, warp+relief), held_out_rms_px, held_out_corners, folds, chosen; None unless chosen.");
   cls.def_property_readonly(
       "holdout",
       [record](const Holder& holder) -> py::object {
@@ -410,10 +421,10 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
                         int max_iterations, int detection_passes, int threads, bool leave_one_out,
                         const py::object& tolerances, const std::vector<double>& distances_mm,
                         const std::vector<double>& distances_n, double max_predicted_error_px, double rim_field_deg,
-                        int holdout, int holdout_folds, bool cross_validate, double cross_validation_distance_mm, bool board_warp,
-                        bool view_weights, std::optional<bool> checkerboard_edges,
+                        int holdout, int holdout_folds, bool cross_validate, double cross_validation_distance_mm,
+                        bool board_warp, bool view_weights, std::optional<bool> checkerboard_edges,
                         const py::object& knots, const std::string& lens, const std::string& tangential,
-                        py::object progress) {
+                        const std::string& board_relief, py::object progress) {
   CalibrationInput input;
   PyTarget target = TargetOf(target_arg);
   input.target = std::move(target.board);
@@ -464,6 +475,7 @@ PyCalibration Calibrate(const py::object& target_arg, const py::object& images, 
   }
   options.lens = lens;
   options.tangential = tangential;
+  options.board_relief = board_relief;
   options.cross_validate = cross_validate;
   options.cross_validation_distance_mm = cross_validation_distance_mm;
   options.progress = ForwardProgress(std::move(progress));
@@ -740,9 +752,10 @@ are also attributes here), the warnings with their codes, the views and residual
         "guess"_a = py::none(), "profile"_a = "", "fixed"_a = py::tuple(), "loss_px"_a = 1.0, "max_iterations"_a = 200,
         "detection_passes"_a = 2, "threads"_a = 0, "leave_one_out"_a = false, "tolerances"_a = py::none(),
         "distances_mm"_a = std::vector<double>(), "distances_n"_a = std::vector<double>(),
-        "max_predicted_error_px"_a = 0.3, "rim_field_deg"_a = kDefaultRimFieldDeg, "holdout"_a = 0, "holdout_folds"_a = 0,
-        "cross_validate"_a = false, "cross_validation_distance_mm"_a = 0.0, "board_warp"_a = true, "view_weights"_a = false,
-        "checkerboard_edges"_a = py::none(), "knots"_a = 0, "lens"_a = "", "tangential"_a = "", "progress"_a = py::none(),
+        "max_predicted_error_px"_a = 0.3, "rim_field_deg"_a = kDefaultRimFieldDeg, "holdout"_a = 0,
+        "holdout_folds"_a = 0, "cross_validate"_a = false, "cross_validation_distance_mm"_a = 0.0,
+        "board_warp"_a = true, "view_weights"_a = false, "checkerboard_edges"_a = py::none(), "knots"_a = 0,
+        "lens"_a = "", "tangential"_a = "", "board_relief"_a = "", "progress"_a = py::none(),
         R"(Calibrates the sensor (as `omnical calibrate`) -> CalibrationResult.
 
 target: a Target or a spec path. Corners: images (as detect(): a directory or glob, a
@@ -772,7 +785,9 @@ full set's). cross_validate: each half of the
 views calibrated and compared at cross_validation_distance_mm (0: the first distance
 asked, else 2000) after the best rigid alignment (result.cross_validation). board_warp:
 fit the board's out-of-plane warp (result.board_warp, mm; the default, False holds the
-board flat). view_weights: weight
+board flat). board_relief: each corner's own out-of-plane offset on top of the warp, 'off',
+'on' (fitted) or 'auto' ('' without a guess: fitted where that predicts held-out folds
+better, result.relief_choice; result.board_warp['relief']). view_weights: weight
 each view's corners by its own noise, estimated from its residuals
 (result.per_view_weight). checkerboard_edges: None (default) refines a checkerboard's
 corners through the first fit by their edges, every one, where that applies; True asks

@@ -473,7 +473,10 @@ def write_document(path, results, cli, quick, checkerboard_subpixel, seconds):
            "`detections.json`). mrcal fits its richest central model, LENSMODEL_SPLINED_STEREOGRAPHIC; omnical "
            "its non-central mirror model (`calibrate --detections --board-warp`, with `--holdout` and "
            "`--cross-validate` for the last two columns). Both fit the board's warp (mrcal's calobject_warp, "
-           "omnical's `--board-warp`: the same paraboloid model). Definitions below the tables.", "",
+           "omnical's `--board-warp`: the same paraboloid model); without a guess omnical also fits the board's "
+           "relief where held-out folds choose it (`--board-relief`: each corner's own offset, one board "
+           "parameter per corner, not counted among the intrinsic parameters, as neither tool counts its warp). "
+           "Definitions below the tables.", "",
            "| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
     for result in results:
         label = f"{result['dataset'].name}: {result['dataset'].label}"

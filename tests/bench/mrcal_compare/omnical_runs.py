@@ -269,7 +269,8 @@ def _project(omnical_cli, sensor_path, points_mm):
 def board_warp_offsets_mm(calibration, board, ids):
     """Out-of-plane offsets (mm) of the corners `ids` under the fit's board warp
     (calibration.json "board_warp", calib/board_warp.h): z = x_mm (1 - u^2) + y_mm (1 - v^2),
-    u, v the corner scaled to [-1, 1] over the extent of all the board's corners; 0 without one."""
+    u, v the corner scaled to [-1, 1] over the extent of all the board's corners, plus each
+    corner's own relief where one was fitted ("relief": id, offset_mm); 0 without one."""
     warp = calibration.get("board_warp")
     if not warp:
         return np.zeros(len(ids))
@@ -279,7 +280,8 @@ def board_warp_offsets_mm(calibration, board, ids):
     xy = np.array([board.points_mm[i] for i in ids], dtype=float)
     uv = 2.0 * (xy - low) / span - 1.0
     basis = np.where(high > low, 1.0 - uv ** 2, 0.0)
-    return basis @ np.array([float(warp["x_mm"]), float(warp["y_mm"])])
+    relief = {int(c["id"]): float(c["offset_mm"]) for c in warp.get("relief", [])}
+    return basis @ np.array([float(warp["x_mm"]), float(warp["y_mm"])]) + np.array([relief.get(i, 0.0) for i in ids])
 
 
 def omnical_corner_residuals(omnical_cli, calibration, board, views):
