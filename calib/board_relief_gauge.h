@@ -3,7 +3,7 @@
 // along its normal, which every pose takes up) and the warp's two paraboloid factors
 // (which the warp block moves) are in its span with nothing in the data to tell them
 // apart. Left to the relief's prior alone they made the warp's std 0.39 mm on the real Mei
-// set where the data give 0.10. So the relief is held orthogonal to those three shapes
+// set where the data give 0.07. So the relief is held orthogonal to those three shapes
 // over the fitted corners: what is reported is the board's shape less its mean and its
 // paraboloid. Not the planes x and y: a tilt of the board takes them up only to first
 // order (it also moves the bent corners within the plane, by the tilt times their
