@@ -399,6 +399,18 @@ TEST(BundleFit, RecoversABoardWarpFromExactObservations) {
   EXPECT_GT(flat.rms_px, 0.05);  // a 3 mm sag at 0.2-1.3 m moves corners by tenths of a px
 }
 
+// The warp of the test above (3 mm, -2 mm) plus a relief: a Gaussian bump of bump_mm at
+// the board's corner of highest x and y, a quarter of the board's width wide.
+BoardWarp BumpedWarp(const CalibrationTarget& board, double bump_mm) {
+  const WarpedSurface extent = WarpedSurface::Of(board, BoardWarp());
+  const double width_mm = (extent.high_mm - extent.low_mm).maxCoeff();
+  BoardWarp warp{3.0, -2.0};
+  for (const TargetCorner& c : board.corners())
+    warp.relief_mm[c.id] = bump_mm * std::exp(-(c.point_in_target.head<2>() - extent.high_mm).squaredNorm() /
+                                              (2.0 * std::pow(0.25 * width_mm, 2)));
+  return warp;
+}
+
 // A board the paraboloid cannot describe: the warp above plus a 1.5 mm bump at one corner
 // of the card (a Gaussian a quarter of the board wide), the board's relief
 // (BoardWarp::relief_mm). From exact corners the fit with the relief gives the board's
@@ -414,16 +426,7 @@ TEST(BundleFit, RecoversABoardsReliefFromExactObservations) {
       LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-sph-misaligned.yaml");
   const std::vector<SceneView> views = MixedDistanceViews(truth_sensor);
   const CalibrationTarget& board = *views[0].targets[0].target;
-  Eigen::Vector2d low = Eigen::Vector2d::Constant(HUGE_VAL), high = -low;
-  for (const TargetCorner& c : board.corners()) {
-    low = low.cwiseMin(c.point_in_target.head<2>());
-    high = high.cwiseMax(c.point_in_target.head<2>());
-  }
-  const double width_mm = (high - low).maxCoeff();
-  BoardWarp warp{3.0, -2.0};
-  for (const TargetCorner& c : board.corners())
-    warp.relief_mm[c.id] =
-        1.5 * std::exp(-(c.point_in_target.head<2>() - high).squaredNorm() / (2.0 * std::pow(0.25 * width_mm, 2)));
+  const BoardWarp warp = BumpedWarp(board, 1.5);
   const Truth truth = WarpedObservations(truth_sensor, warp);
   FitOptions options = FitOptions::DefaultsFor(truth.sensor);
   options.fit_board_warp = options.fit_board_relief = true;
@@ -475,19 +478,9 @@ TEST(BundleFit, ABentBoardsReliefBringsTheSensorNearerTheTruth) {
       LoadSensorYaml(testing::SourceDir() + "/datasets-synthetic/sensors/ohte-sph-misaligned.yaml");
   const std::vector<SceneView> views = MixedDistanceViews(truth_sensor);
   const CalibrationTarget& board = *views[0].targets[0].target;
-  Eigen::Vector2d low = Eigen::Vector2d::Constant(HUGE_VAL), high = -low;
-  for (const TargetCorner& c : board.corners()) {
-    low = low.cwiseMin(c.point_in_target.head<2>());
-    high = high.cwiseMax(c.point_in_target.head<2>());
-  }
-  const double width_mm = (high - low).maxCoeff();
   // From the truth at 300 mm, fitted with the warp alone and with the relief.
   auto from_truth_px = [&](double bump_mm, int seed) {
-    BoardWarp warp{3.0, -2.0};
-    for (const TargetCorner& c : board.corners())
-      warp.relief_mm[c.id] = bump_mm * std::exp(-(c.point_in_target.head<2>() - high).squaredNorm() /
-                                                (2.0 * std::pow(0.25 * width_mm, 2)));
-    Truth truth = WarpedObservations(truth_sensor, warp);
+    Truth truth = WarpedObservations(truth_sensor, BumpedWarp(board, bump_mm));
     std::mt19937 rng(seed);
     std::normal_distribution<double> noise(0.0, 0.3);
     for (ImageDetections& image : truth.detections.images)
